@@ -1,0 +1,26 @@
+// What a run writes: state files (JSON), meshes (Wavefront OBJ), traces (CSV).
+// Files are written to a temporary name beside the target and renamed, so a reader never sees a
+// half-written file and a failed run leaves none behind.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "drape/scene/scene.hpp"
+#include "drape/sim/world.hpp"
+
+namespace drape::scene {
+
+// Throws InputError naming the file when it cannot be written.
+void writeFileAtomically(const std::filesystem::path& file, std::string_view contents);
+
+// Positions of every particle (row by row: index = row * columns + column) and the run's metrics.
+nlohmann::json stateDocument(const Scene& scene, const sim::World& world);
+
+// Positions, normals and triangles (or line segments for a chain) of every cloth.
+std::string objText(const sim::World& world);
+
+}  // namespace drape::scene

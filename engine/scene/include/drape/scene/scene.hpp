@@ -1,0 +1,43 @@
+// Scene files: JSON <-> engine settings, with strict validation.
+//
+// Every key is documented in docs/scenes.md with its unit and range. Unknown keys, wrong types,
+// out-of-range and non-finite values are errors naming the file and the key's dotted path
+// (`cloths.0.grid.columns`), the same path `--set` takes. Nothing the user wrote is silently
+// replaced; only keys that are absent take their documented defaults.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "drape/sim/settings.hpp"
+
+namespace drape::scene {
+
+struct Scene {
+  std::string source;       // file the scene came from (for messages)
+  std::string name;         // short name, defaults to the file's stem
+  std::string description;  // one line for humans
+  double duration = 5.0;    // s, how long a run lasts when the caller does not say
+  sim::WorldSettings world;
+};
+
+// Reads, overrides and validates a scene file. Throws InputError.
+Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
+
+// Validates an already parsed document; `source` names it in messages. Throws InputError.
+Scene parseScene(const nlohmann::json& document, const std::string& source);
+
+// Applies one `dotted.path=value` assignment to a document. The value is read as JSON when it is
+// valid JSON (numbers, true, [1,2,3]) and as a string otherwise (`solver.model=force`). Missing
+// object keys on the way are created; array indices must exist. Throws InputError.
+void applyOverride(nlohmann::json& document, std::string_view assignment);
+
+// Finds a scene by path, or by name in the shipped scenes folder (`hang` -> assets/scenes/hang.json).
+std::filesystem::path resolveScenePath(const std::string& nameOrPath);
+std::filesystem::path sceneDirectory();
+
+}  // namespace drape::scene

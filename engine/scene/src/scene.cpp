@@ -1,0 +1,221 @@
+#include "drape/scene/scene.hpp"
+
+#include <charconv>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/scene/error.hpp"
+#include "json_reader.hpp"
+
+namespace drape::scene {
+
+namespace {
+
+using nlohmann::json;
+using sim::ConstraintKind;
+using sim::KindMaterial;
+using sim::Model;
+
+constexpr int kMaxCloths = 64;
+constexpr std::size_t kMaxPins = 100000;
+constexpr double kMaxCoordinate = 1.0e4;  // m
+
+// Defaults per model: the position model's 0..1 stiffnesses, and the force model's springs in N/m
+// and N s/m (sized for a ~1 kg sheet of a few hundred particles).
+KindMaterial defaultMaterial(Model model, ConstraintKind kind) {
+  if (model == Model::position) {
+    switch (kind) {
+      case ConstraintKind::stretch: return {1.0f, 0.0f};
+      case ConstraintKind::shear: return {1.0f, 0.0f};
+      case ConstraintKind::bend: return {0.2f, 0.0f};
+    }
+  }
+  switch (kind) {
+    case ConstraintKind::stretch: return {2000.0f, 1.0f};
+    case ConstraintKind::shear: return {2000.0f, 1.0f};
+    case ConstraintKind::bend: return {200.0f, 0.1f};
+  }
+  return {};
+}
+
+KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model) {
+  KindMaterial material = defaultMaterial(model, kind);
+  const std::string_view key = sim::name(kind);
+  if (!cloth.has(key)) return material;
+  ObjectReader reader = cloth.object(key);
+  if (model == Model::position) {
+    material.stiffness = static_cast<float>(reader.number("stiffness", material.stiffness, {0.0, 1.0, false, "fraction corrected per sweep"}));
+    material.damping = static_cast<float>(reader.number("damping", material.damping, {0.0, 1.0, false, "fraction of relative velocity removed per substep"}));
+  } else {
+    material.stiffness = static_cast<float>(reader.number("stiffness", material.stiffness, {0.0, 1.0e9, false, "N/m"}));
+    material.damping = static_cast<float>(reader.number("damping", material.damping, {0.0, 1.0e6, false, "N s/m"}));
+  }
+  reader.finish();
+  return material;
+}
+
+sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& particleBudget) {
+  sim::ClothSettings cloth;
+  ObjectReader grid = reader.object("grid");
+  sim::LatticeSpec& lattice = cloth.lattice;
+  lattice.columns = grid.integer("columns", 2, 1, sim::kMaxLatticeSide);
+  lattice.rows = grid.integer("rows", 2, 1, sim::kMaxLatticeSide);
+  lattice.width = static_cast<float>(grid.number("width", 1.0, {0.0, 1000.0, true, "m"}));
+  lattice.height = static_cast<float>(grid.number("height", 1.0, {0.0, 1000.0, true, "m"}));
+  const long long particles = static_cast<long long>(lattice.columns) * lattice.rows;
+  if (particles > particleBudget) {
+    throw InputError(reader.source() + ": " + reader.pathOf("grid") + ": " + std::to_string(lattice.columns) +
+                     " x " + std::to_string(lattice.rows) + " particles pass the limit of " +
+                     std::to_string(sim::kMaxParticles) + " particles over all cloths");
+  }
+  particleBudget -= particles;
+  grid.finish();
+
+  lattice.origin = reader.vec3("origin", sim::Vec3{0.0f}, kMaxCoordinate, "m");
+  lattice.plane = reader.choice("plane", "xz", {"xz", "xy"}) == "xz" ? sim::LatticePlane::xz : sim::LatticePlane::xy;
+  cloth.mass = static_cast<float>(reader.number("mass", 1.0, {0.0, 1.0e6, true, "kg"}));
+  for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model);
+
+  const json& pins = reader.array("pins", kMaxPins);
+  for (std::size_t i = 0; i < pins.size(); ++i) {
+    ObjectReader pin(pins[i], reader.pathOf("pins") + "." + std::to_string(i), reader.source());
+    const std::string expected = "[column, row] inside the " + std::to_string(lattice.columns) + " x " +
+                                 std::to_string(lattice.rows) + " grid";
+    const json* found = pin.raw("particle");
+    if (!found) pin.fail("particle", expected, nullptr);
+    const json& particle = *found;
+    const bool ok = particle.is_array() && particle.size() == 2 && particle[0].is_number_integer() &&
+                    particle[1].is_number_integer() && particle[0].get<long long>() >= 0 &&
+                    particle[0].get<long long>() < lattice.columns && particle[1].get<long long>() >= 0 &&
+                    particle[1].get<long long>() < lattice.rows;
+    if (!ok) pin.fail("particle", expected, &particle);
+    sim::Pin result{particle[0].get<int>(), particle[1].get<int>(), std::nullopt};
+    if (pin.has("position")) result.position = pin.vec3("position", sim::Vec3{0.0f}, kMaxCoordinate, "m");
+    pin.finish();
+    cloth.pins.push_back(result);
+  }
+  reader.finish();
+  return cloth;
+}
+
+}  // namespace
+
+Scene parseScene(const json& document, const std::string& source) {
+  Scene scene;
+  scene.source = source;
+  ObjectReader root(document, "", source);
+  scene.name = root.text("name", std::filesystem::path(source).stem().string());
+  scene.description = root.text("description", "");
+  scene.duration = root.number("duration", 5.0, {0.0, 1.0e5, true, "s"});
+
+  sim::WorldSettings& world = scene.world;
+  if (root.has("solver")) {
+    ObjectReader solver = root.object("solver");
+    world.solver.model = *sim::parseModel(solver.choice("model", "position", {"position", "force"}));
+    world.solver.integrator = *sim::parseIntegrator(
+        solver.choice("integrator", "verlet", {"explicit-euler", "symplectic-euler", "verlet", "midpoint", "rk4"}));
+    if (world.solver.model == Model::position && world.solver.integrator != sim::Integrator::verlet) {
+      solver.fail("integrator", "\"verlet\" for the position model (the others belong to \"model\": \"force\")",
+                  solver.raw("integrator"));
+    }
+    world.solver.dt = solver.number("dt", world.solver.dt, {0.0, 1.0, true, "s"});
+    world.solver.substeps = solver.integer("substeps", world.solver.substeps, 1, sim::kMaxSubsteps);
+    world.solver.iterations = solver.integer("iterations", world.solver.iterations, 0, sim::kMaxIterations);
+    world.solver.damping = static_cast<float>(solver.number("damping", 0.0, {0.0, 1000.0, false, "1/s"}));
+    solver.finish();
+  }
+  world.gravity = root.vec3("gravity", world.gravity, 1000.0, "m/s^2");
+  if (root.has("wind")) {
+    ObjectReader wind = root.object("wind");
+    world.air.velocity = wind.vec3("velocity", sim::Vec3{0.0f}, 1000.0, "m/s");
+    world.air.drag = static_cast<float>(wind.number("drag", 0.0, {0.0, 1000.0, false, "1/s"}));
+    world.air.pressure = static_cast<float>(wind.number("pressure", 0.0, {0.0, 1.0e4, false, "kg/(m^2 s)"}));
+    wind.finish();
+  }
+  const json& cloths = root.array("cloths", kMaxCloths);
+  long long particleBudget = sim::kMaxParticles;
+  for (std::size_t i = 0; i < cloths.size(); ++i) {
+    ObjectReader cloth(cloths[i], "cloths." + std::to_string(i), source);
+    world.cloths.push_back(readCloth(cloth, world.solver.model, particleBudget));
+  }
+  root.finish();
+  return scene;
+}
+
+void applyOverride(json& document, std::string_view assignment) {
+  const std::string where = "--set " + std::string(assignment);
+  const std::size_t equals = assignment.find('=');
+  if (equals == std::string_view::npos || equals == 0) {
+    throw InputError(where + ": expected path=value, e.g. cloths.0.grid.columns=64");
+  }
+  const std::string_view path = assignment.substr(0, equals);
+  const std::string_view valueText = assignment.substr(equals + 1);
+  json value = json::parse(valueText, nullptr, false);
+  if (value.is_discarded()) value = std::string(valueText);
+
+  json* node = &document;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t dot = path.find('.', begin);
+    const std::string_view segment = path.substr(begin, dot == std::string_view::npos ? path.size() - begin : dot - begin);
+    if (segment.empty()) throw InputError(where + ": empty key in the path");
+    json* next = nullptr;
+    if (node->is_array()) {
+      std::size_t index = 0;
+      const auto [end, error] = std::from_chars(segment.data(), segment.data() + segment.size(), index);
+      if (error != std::errc{} || end != segment.data() + segment.size() || index >= node->size()) {
+        throw InputError(where + ": " + std::string(segment) + " is not an index of an array of " +
+                         std::to_string(node->size()));
+      }
+      next = &(*node)[index];
+    } else if (node->is_object() || node->is_null()) {
+      next = &(*node)[std::string(segment)];
+    } else {
+      throw InputError(where + ": cannot go into " + describe(*node) + " at " + std::string(segment));
+    }
+    if (dot == std::string_view::npos) {
+      *next = value;
+      return;
+    }
+    node = next;
+    begin = dot + 1;
+  }
+}
+
+std::filesystem::path sceneDirectory() {
+  return std::filesystem::path(DRAPE_ASSET_DIR) / "scenes";
+}
+
+std::filesystem::path resolveScenePath(const std::string& nameOrPath) {
+  const std::filesystem::path direct(nameOrPath);
+  if (std::filesystem::exists(direct)) return direct;
+  if (direct.parent_path().empty()) {
+    std::filesystem::path shipped = sceneDirectory() / direct;
+    if (!shipped.has_extension()) shipped += ".json";
+    if (std::filesystem::exists(shipped)) return shipped;
+  }
+  return direct;
+}
+
+Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  const std::string source = file.string();
+  std::ifstream in(file, std::ios::binary);
+  if (!in || std::filesystem::is_directory(file)) throw InputError(source + ": cannot open the scene file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  json document;
+  try {
+    document = json::parse(text.str());
+  } catch (const json::parse_error& e) {
+    // nlohmann's message: "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
+    std::string message = e.what();
+    const std::size_t at = message.find("parse error");
+    throw InputError(source + ": malformed JSON: " + (at == std::string::npos ? message : message.substr(at)));
+  }
+  for (const std::string& assignment : overrides) applyOverride(document, assignment);
+  return parseScene(document, source);
+}
+
+}  // namespace drape::scene

@@ -1,0 +1,75 @@
+// A cloth's rest description: what it is, as opposed to where it is (state.hpp).
+//
+// The lattice follows the seed (Provot 1995): particles on a regular grid joined by distance
+// constraints of three kinds that resist stretching (structural neighbours), shearing (diagonal
+// neighbours) and bending (neighbours two apart). Triangles exist for rendering, normals and
+// aerodynamic forces. Rest data is built once and never changes while the cloth is simulated.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "drape/sim/types.hpp"
+
+namespace drape::sim {
+
+enum class ConstraintKind : std::uint8_t { stretch, shear, bend };
+inline constexpr std::size_t kConstraintKindCount = 3;
+inline constexpr std::array<ConstraintKind, kConstraintKindCount> kConstraintKinds = {
+    ConstraintKind::stretch, ConstraintKind::shear, ConstraintKind::bend};
+std::string_view name(ConstraintKind kind);
+
+// Two particles that want to stay restLength apart.
+struct DistanceConstraint {
+  ParticleIndex a;
+  ParticleIndex b;
+  float restLength;  // m
+};
+
+// Which world plane the lattice is laid out in at rest.
+enum class LatticePlane : std::uint8_t {
+  xz,  // lying flat: columns along +x, rows along +z, at height origin.y
+  xy,  // hanging: columns along +x, rows downwards along -y
+};
+std::string_view name(LatticePlane plane);
+
+struct LatticeSpec {
+  int columns = 2;                 // particles along a row, >= 1
+  int rows = 2;                    // particles along a column, >= 1 (1 makes a chain)
+  float width = 1.0f;              // m, distance from column 0 to the last column
+  float height = 1.0f;             // m, distance from row 0 to the last row
+  Vec3 origin{0.0f};               // m, rest position of particle (column 0, row 0)
+  LatticePlane plane = LatticePlane::xz;
+};
+
+struct ClothRest {
+  int columns = 0;
+  int rows = 0;
+  std::vector<Vec3> restPositions;          // m, index = row * columns + column
+  std::vector<glm::uvec3> triangles;        // counter-clockwise seen from the front (+y or +z)
+  std::array<std::vector<DistanceConstraint>, kConstraintKindCount> constraints;  // by kind
+
+  std::size_t particleCount() const { return restPositions.size(); }
+  ParticleIndex index(int column, int row) const {
+    return static_cast<ParticleIndex>(row * columns + column);
+  }
+  const std::vector<DistanceConstraint>& of(ConstraintKind kind) const {
+    return constraints[static_cast<std::size_t>(kind)];
+  }
+};
+
+// Which constraint kinds to generate: a kind the cloth does not use costs no memory and no time.
+struct ConstraintSelection {
+  bool stretch = true;
+  bool shear = true;
+  bool bend = true;
+};
+
+// Builds the lattice. Throws std::invalid_argument if the spec is not a valid lattice.
+ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection = {});
+
+}  // namespace drape::sim

@@ -1,0 +1,33 @@
+// Measurements of a world: strain of the structural constraints and mechanical energy.
+// Computed on demand, never inside the step.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "drape/sim/world.hpp"
+
+namespace drape::sim {
+
+// Strain of a constraint: e = |x_b - x_a| / restLength - 1 (0 at rest, 0.05 = 5 % stretched).
+struct StrainStats {
+  double max = 0.0;   // largest e over all structural constraints (most stretched)
+  double mean = 0.0;  // mean of |e|
+  std::size_t count = 0;
+};
+
+struct Energy {
+  double kinetic = 0.0;        // J, sum of m v^2 / 2
+  double gravitational = 0.0;  // J, sum of -m g . x (zero at the origin)
+  double elastic = 0.0;        // J, force model: sum of ks (|dx| - r)^2 / 2; 0 for the position model
+  double total() const { return kinetic + gravitational + elastic; }
+};
+
+StrainStats structuralStrain(const World& world);
+Energy energy(const World& world);
+
+// Per-vertex normals (area-weighted sum of adjacent triangle normals, normalised); particles on no
+// triangle get the lattice plane's normal.
+std::vector<Vec3> vertexNormals(const Cloth& cloth);
+
+}  // namespace drape::sim

@@ -1,0 +1,94 @@
+// What a simulation is asked to do: the engine-side mirror of a scene file, already validated.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "drape/sim/cloth.hpp"
+#include "drape/sim/types.hpp"
+
+namespace drape::sim {
+
+// The seed's two models of cloth.
+enum class Model : std::uint8_t {
+  position,  // Verlet + iterative constraint satisfaction (Provot 1995, Jakobsen 2001)
+  force,     // mass-spring-damper forces integrated by one of the integrators below
+};
+
+// Integrators of the force model. The position model always uses Verlet.
+enum class Integrator : std::uint8_t {
+  explicitEuler,    // x += v dt; v += a(x, v) dt                        (first order, never stable undamped)
+  symplecticEuler,  // v += a(x, v) dt; x += v dt      the seed's "Euler" (first order)
+  verlet,           // x' = 2x - x_prev + a dt^2       the seed's Verlet  (second order)
+  midpoint,         // RK2 with the derivative at the half step          (second order)
+  rk4,              // classical Runge-Kutta                              (fourth order)
+};
+
+std::string_view name(Model model);
+std::string_view name(Integrator integrator);
+std::optional<Model> parseModel(std::string_view text);
+std::optional<Integrator> parseIntegrator(std::string_view text);
+
+struct SolverSettings {
+  Model model = Model::position;
+  Integrator integrator = Integrator::verlet;  // force model only
+  double dt = 1.0 / 60.0;                      // s, one step
+  int substeps = 1;                            // each step is split into this many equal substeps
+  int iterations = 20;                         // position model: constraint sweeps per substep
+  float damping = 0.0f;                        // 1/s, global velocity damping: a -= damping * v
+};
+
+// The air around the cloth, moving uniformly at `velocity`.
+struct AirSettings {
+  Vec3 velocity{0.0f};   // m/s, the wind
+  float drag = 0.0f;     // 1/s, linear drag towards the air's velocity: a -= drag * (v - wind)
+  float pressure = 0.0f; // kg/(m^2 s), force on a triangle along its normal:
+                         //   f = pressure * area * ((wind - v) . n) n   (what makes a flag flutter)
+};
+
+// How one constraint kind resists. Units depend on the model:
+//   position: stiffness in 0..1 (fraction of the violation corrected per sweep, the seed's 1/2 each
+//             side at 1), damping in 0..1 (fraction of the relative velocity along the constraint
+//             removed per substep);
+//   force:    stiffness ks in N/m, damping kd in N s/m (the seed's spring-damper).
+struct KindMaterial {
+  float stiffness = 1.0f;
+  float damping = 0.0f;
+};
+
+struct Pin {
+  int column = 0;
+  int row = 0;
+  std::optional<Vec3> position;  // m; absent: held where the lattice puts it
+};
+
+struct ClothSettings {
+  LatticeSpec lattice;
+  float mass = 1.0f;  // kg, spread evenly over the particles
+  std::array<KindMaterial, kConstraintKindCount> materials{};
+  std::vector<Pin> pins;
+
+  KindMaterial& material(ConstraintKind kind) { return materials[static_cast<std::size_t>(kind)]; }
+  const KindMaterial& material(ConstraintKind kind) const {
+    return materials[static_cast<std::size_t>(kind)];
+  }
+};
+
+struct WorldSettings {
+  SolverSettings solver;
+  Vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2
+  AirSettings air;
+  std::vector<ClothSettings> cloths;
+};
+
+// Limits the engine accepts; the scene layer reports them to the user.
+inline constexpr int kMaxLatticeSide = 4096;
+inline constexpr long long kMaxParticles = 1 << 20;  // over all cloths of a world
+inline constexpr int kMaxSubsteps = 1000;
+inline constexpr int kMaxIterations = 10000;
+// A particle farther than this from the origin is a runaway: the guard treats it like NaN.
+inline constexpr float kRunawayDistance = 1.0e6f;  // m
+
+}  // namespace drape::sim

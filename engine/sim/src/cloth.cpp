@@ -1,0 +1,101 @@
+#include "drape/sim/cloth.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "drape/sim/settings.hpp"
+
+namespace drape::sim {
+
+std::string_view name(ConstraintKind kind) {
+  switch (kind) {
+    case ConstraintKind::stretch: return "stretch";
+    case ConstraintKind::shear: return "shear";
+    case ConstraintKind::bend: return "bend";
+  }
+  return "?";
+}
+
+std::string_view name(LatticePlane plane) {
+  switch (plane) {
+    case LatticePlane::xz: return "xz";
+    case LatticePlane::xy: return "xy";
+  }
+  return "?";
+}
+
+namespace {
+
+void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
+  const float restLength = glm::length(rest.restPositions[b] - rest.restPositions[a]);
+  rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
+}
+
+}  // namespace
+
+ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
+  if (spec.columns < 1 || spec.rows < 1 || spec.columns > kMaxLatticeSide ||
+      spec.rows > kMaxLatticeSide ||
+      static_cast<long long>(spec.columns) * spec.rows > kMaxParticles) {
+    throw std::invalid_argument("lattice of " + std::to_string(spec.columns) + " x " +
+                                std::to_string(spec.rows) + " particles is outside the limits");
+  }
+  if (!(spec.width > 0.0f) || !(spec.height > 0.0f)) {
+    throw std::invalid_argument("lattice width and height must be positive");
+  }
+
+  ClothRest rest;
+  rest.columns = spec.columns;
+  rest.rows = spec.rows;
+  const float dx = spec.columns > 1 ? spec.width / static_cast<float>(spec.columns - 1) : 0.0f;
+  const float dy = spec.rows > 1 ? spec.height / static_cast<float>(spec.rows - 1) : 0.0f;
+  // Unit vectors of the lattice's column and row directions in the world.
+  const Vec3 along{1.0f, 0.0f, 0.0f};
+  const Vec3 down = spec.plane == LatticePlane::xz ? Vec3{0.0f, 0.0f, 1.0f} : Vec3{0.0f, -1.0f, 0.0f};
+
+  rest.restPositions.reserve(static_cast<std::size_t>(spec.columns) * spec.rows);
+  for (int row = 0; row < spec.rows; ++row) {
+    for (int column = 0; column < spec.columns; ++column) {
+      rest.restPositions.push_back(spec.origin + along * (dx * static_cast<float>(column)) +
+                                   down * (dy * static_cast<float>(row)));
+    }
+  }
+
+  // Triangles wound counter-clockwise when seen from +y (xz plane) or +z (xy plane).
+  for (int row = 0; row + 1 < spec.rows; ++row) {
+    for (int column = 0; column + 1 < spec.columns; ++column) {
+      const ParticleIndex p00 = rest.index(column, row), p10 = rest.index(column + 1, row);
+      const ParticleIndex p01 = rest.index(column, row + 1), p11 = rest.index(column + 1, row + 1);
+      if (spec.plane == LatticePlane::xz) {
+        rest.triangles.push_back({p00, p01, p10});
+        rest.triangles.push_back({p10, p01, p11});
+      } else {
+        rest.triangles.push_back({p00, p01, p11});
+        rest.triangles.push_back({p00, p11, p10});
+      }
+    }
+  }
+
+  for (int row = 0; row < spec.rows; ++row) {
+    for (int column = 0; column < spec.columns; ++column) {
+      const ParticleIndex p = rest.index(column, row);
+      if (selection.stretch) {
+        if (column + 1 < spec.columns) addConstraint(rest, ConstraintKind::stretch, p, rest.index(column + 1, row));
+        if (row + 1 < spec.rows) addConstraint(rest, ConstraintKind::stretch, p, rest.index(column, row + 1));
+      }
+      if (selection.shear && column + 1 < spec.columns && row + 1 < spec.rows) {
+        addConstraint(rest, ConstraintKind::shear, p, rest.index(column + 1, row + 1));
+        addConstraint(rest, ConstraintKind::shear, rest.index(column + 1, row), rest.index(column, row + 1));
+      }
+      if (selection.bend) {
+        if (column + 2 < spec.columns) addConstraint(rest, ConstraintKind::bend, p, rest.index(column + 2, row));
+        if (row + 2 < spec.rows) addConstraint(rest, ConstraintKind::bend, p, rest.index(column, row + 2));
+      }
+    }
+  }
+  return rest;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,75 @@
+#include "drape/sim/metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+namespace drape::sim {
+
+StrainStats structuralStrain(const World& world) {
+  StrainStats stats;
+  stats.max = -1.0;
+  double sumAbs = 0.0;
+  for (const Cloth& cloth : world.cloths()) {
+    for (const DistanceConstraint& c : cloth.rest.of(ConstraintKind::stretch)) {
+      if (!(c.restLength > 0.0f)) continue;
+      const double strain =
+          static_cast<double>(glm::length(cloth.state.position[c.b] - cloth.state.position[c.a])) / c.restLength - 1.0;
+      stats.max = std::max(stats.max, strain);
+      sumAbs += std::abs(strain);
+      ++stats.count;
+    }
+  }
+  if (stats.count == 0) {
+    stats.max = 0.0;
+    return stats;
+  }
+  stats.mean = sumAbs / static_cast<double>(stats.count);
+  return stats;
+}
+
+Energy energy(const World& world) {
+  Energy e;
+  const Vec3 g = world.settings().gravity;
+  for (std::size_t c = 0; c < world.cloths().size(); ++c) {
+    const Cloth& cloth = world.cloths()[c];
+    const double m = cloth.particleMass;
+    for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+      if (cloth.state.inverseMass[i] == 0.0f) continue;  // pinned: held by the world, no energy of its own
+      const Vec3 v = world.velocity(static_cast<int>(c), static_cast<ParticleIndex>(i));
+      e.kinetic += 0.5 * m * static_cast<double>(glm::dot(v, v));
+      e.gravitational -= m * static_cast<double>(glm::dot(g, cloth.state.position[i]));
+    }
+    if (world.settings().solver.model != Model::force) continue;
+    for (ConstraintKind kind : kConstraintKinds) {
+      const double ks = cloth.settings.material(kind).stiffness;
+      for (const DistanceConstraint& con : cloth.rest.of(kind)) {
+        const double stretch =
+            static_cast<double>(glm::length(cloth.state.position[con.b] - cloth.state.position[con.a])) - con.restLength;
+        e.elastic += 0.5 * ks * stretch * stretch;
+      }
+    }
+  }
+  return e;
+}
+
+std::vector<Vec3> vertexNormals(const Cloth& cloth) {
+  const std::vector<Vec3>& x = cloth.state.position;
+  std::vector<Vec3> normals(x.size(), Vec3{0.0f});
+  for (const glm::uvec3& t : cloth.rest.triangles) {
+    const Vec3 n = glm::cross(x[t.y] - x[t.x], x[t.z] - x[t.x]);  // length = twice the area
+    normals[t.x] += n;
+    normals[t.y] += n;
+    normals[t.z] += n;
+  }
+  const Vec3 planeNormal =
+      cloth.settings.lattice.plane == LatticePlane::xz ? Vec3{0.0f, 1.0f, 0.0f} : Vec3{0.0f, 0.0f, 1.0f};
+  for (Vec3& n : normals) {
+    const float length = glm::length(n);
+    n = length > 0.0f ? n / length : planeNormal;
+  }
+  return normals;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,42 @@
+// The position-based model: Verlet integration and iterative constraint satisfaction, as in the
+// seed (Provot 1995; Jakobsen, "Advanced Character Physics", 2001).
+#pragma once
+
+#include <vector>
+
+#include "drape/sim/settings.hpp"
+#include "drape/sim/world.hpp"
+
+namespace drape::sim::position {
+
+// Verlet needs x_prev at t = -h. A Taylor start, x_prev = x - v0 h + a0 h^2 / 2, makes Verlet
+// reproduce x0 + v0 t + a t^2 / 2 exactly under constant acceleration; x_prev = x would instead
+// start the cloth with a spurious velocity of a h / 2.
+void startHistory(Cloth& cloth, Vec3 initialAcceleration, float h);
+
+// Adds the aerodynamic force on every triangle to `acceleration` (zeroed first):
+// f = pressure * area * ((wind - v) . n) n, shared equally by the triangle's three particles.
+void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, float h,
+                            std::vector<Vec3>& acceleration);
+
+// x' = x + (x - x_prev) exp(-(damping + drag) h) + (g + drag wind + a_extra) h^2
+// The seed's Verlet step; the velocity term decays exactly as linear damping would, so no damping
+// or drag value can make it overshoot. Pinned particles (inverse mass 0) do not move.
+void integrate(Cloth& cloth, const WorldSettings& world, float h, const std::vector<Vec3>* extraAcceleration);
+
+// `iterations` Gauss-Seidel sweeps over the stretch, shear and bend constraints. Each violated
+// constraint is corrected as the seed writes it, weighted by inverse mass and scaled by the kind's
+// stiffness k:  dx_a = k w_a / (w_a + w_b) (|x_b - x_a| - r) (x_b - x_a) / |x_b - x_a|,
+//               dx_b = -k w_b / (w_a + w_b) (...)
+// With equal masses and k = 1 that is exactly the seed's dx_1 = 1/2 (|x2 - x1| - r)(x2 - x1)/|x2 - x1|.
+void projectConstraints(Cloth& cloth, int iterations);
+
+// Removes the kind's damping fraction of the relative velocity along each constraint, by moving
+// x_prev, conserving momentum.
+void dampConstraints(Cloth& cloth);
+
+// One constraint, exposed for tests.
+void projectDistance(std::vector<Vec3>& position, const std::vector<float>& inverseMass,
+                     const DistanceConstraint& constraint, float stiffness);
+
+}  // namespace drape::sim::position

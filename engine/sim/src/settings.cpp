@@ -1,0 +1,57 @@
+#include "drape/sim/settings.hpp"
+
+#include "drape/sim/pipeline.hpp"
+
+namespace drape::sim {
+
+namespace {
+constexpr std::array kModelNames = {std::pair{Model::position, std::string_view{"position"}},
+                                    std::pair{Model::force, std::string_view{"force"}}};
+constexpr std::array kIntegratorNames = {
+    std::pair{Integrator::explicitEuler, std::string_view{"explicit-euler"}},
+    std::pair{Integrator::symplecticEuler, std::string_view{"symplectic-euler"}},
+    std::pair{Integrator::verlet, std::string_view{"verlet"}},
+    std::pair{Integrator::midpoint, std::string_view{"midpoint"}},
+    std::pair{Integrator::rk4, std::string_view{"rk4"}}};
+
+template <typename Table, typename Enum>
+std::string_view lookupName(const Table& table, Enum value) {
+  for (const auto& [entry, text] : table) {
+    if (entry == value) return text;
+  }
+  return "?";
+}
+
+template <typename Enum, typename Table>
+std::optional<Enum> lookupValue(const Table& table, std::string_view text) {
+  for (const auto& [entry, entryText] : table) {
+    if (entryText == text) return entry;
+  }
+  return std::nullopt;
+}
+}  // namespace
+
+std::string_view name(Model model) { return lookupName(kModelNames, model); }
+std::string_view name(Integrator integrator) { return lookupName(kIntegratorNames, integrator); }
+std::optional<Model> parseModel(std::string_view text) { return lookupValue<Model>(kModelNames, text); }
+std::optional<Integrator> parseIntegrator(std::string_view text) {
+  return lookupValue<Integrator>(kIntegratorNames, text);
+}
+
+std::string_view name(Stage stage) {
+  switch (stage) {
+    case Stage::windPressure: return "wind pressure";
+    case Stage::verletIntegrate: return "verlet integrate";
+    case Stage::projectConstraints: return "project constraints";
+    case Stage::dampConstraints: return "damp constraints";
+    case Stage::explicitEuler: return "explicit euler";
+    case Stage::symplecticEuler: return "symplectic euler";
+    case Stage::verletForces: return "verlet (forces)";
+    case Stage::midpoint: return "midpoint";
+    case Stage::rk4: return "rk4";
+    case Stage::guard: return "guard";
+  }
+  return "?";
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,221 @@
+#include "drape/sim/world.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "force_model.hpp"
+#include "position_model.hpp"
+
+namespace drape::sim {
+
+namespace {
+
+bool finite(float value) { return std::isfinite(value); }
+bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+void require(bool condition, const std::string& what) {
+  if (!condition) throw std::invalid_argument(what);
+}
+
+void validate(const WorldSettings& s) {
+  const SolverSettings& solver = s.solver;
+  require(std::isfinite(solver.dt) && solver.dt > 0.0, "solver.dt must be a positive number of seconds");
+  require(solver.substeps >= 1 && solver.substeps <= kMaxSubsteps, "solver.substeps is out of range");
+  require(solver.iterations >= 0 && solver.iterations <= kMaxIterations, "solver.iterations is out of range");
+  require(finite(solver.damping) && solver.damping >= 0.0f, "solver.damping must be finite and >= 0");
+  require(finite(s.gravity), "gravity must be finite");
+  require(finite(s.air.velocity), "wind velocity must be finite");
+  require(finite(s.air.drag) && s.air.drag >= 0.0f, "wind drag must be finite and >= 0");
+  require(finite(s.air.pressure) && s.air.pressure >= 0.0f, "wind pressure must be finite and >= 0");
+  long long particles = 0;
+  for (const ClothSettings& cloth : s.cloths) {
+    particles += static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
+    require(finite(cloth.mass) && cloth.mass > 0.0f, "cloth mass must be positive");
+    require(finite(cloth.lattice.origin), "cloth origin must be finite");
+    for (const KindMaterial& m : cloth.materials) {
+      require(finite(m.stiffness) && m.stiffness >= 0.0f && finite(m.damping) && m.damping >= 0.0f,
+              "constraint stiffness and damping must be finite and >= 0");
+      if (solver.model == Model::position) {
+        require(m.stiffness <= 1.0f && m.damping <= 1.0f, "position-model stiffness and damping must be in 0..1");
+      }
+    }
+    for (const Pin& pin : cloth.pins) {
+      require(pin.column >= 0 && pin.column < cloth.lattice.columns && pin.row >= 0 && pin.row < cloth.lattice.rows,
+              "pin outside the lattice");
+      require(!pin.position || finite(*pin.position), "pin position must be finite");
+    }
+  }
+  require(particles <= kMaxParticles, "too many particles");
+}
+
+bool used(const KindMaterial& m) { return m.stiffness > 0.0f || m.damping > 0.0f; }
+
+Stage integratorStage(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::explicitEuler: return Stage::explicitEuler;
+    case Integrator::symplecticEuler: return Stage::symplecticEuler;
+    case Integrator::verlet: return Stage::verletForces;
+    case Integrator::midpoint: return Stage::midpoint;
+    case Integrator::rk4: return Stage::rk4;
+  }
+  return Stage::rk4;
+}
+
+Cloth makeCloth(const ClothSettings& settings, Model model) {
+  Cloth cloth;
+  cloth.settings = settings;
+  cloth.rest = buildLattice(settings.lattice, {used(settings.material(ConstraintKind::stretch)),
+                                               used(settings.material(ConstraintKind::shear)),
+                                               used(settings.material(ConstraintKind::bend))});
+  const std::size_t n = cloth.rest.particleCount();
+  cloth.particleMass = settings.mass / static_cast<float>(n);
+  ParticleState& s = cloth.state;
+  s.position = cloth.rest.restPositions;
+  s.inverseMass.assign(n, 1.0f / cloth.particleMass);
+  for (const Pin& pin : settings.pins) {
+    const ParticleIndex p = cloth.rest.index(pin.column, pin.row);
+    s.inverseMass[p] = 0.0f;
+    if (pin.position) s.position[p] = *pin.position;
+  }
+  s.previousPosition = s.position;
+  if (model == Model::force) s.velocity.assign(n, Vec3{0.0f});
+  return cloth;
+}
+
+}  // namespace
+
+World::World(WorldSettings settings) : settings_(std::move(settings)) {
+  validate(settings_);
+  const Model model = settings_.solver.model;
+  bool anyTriangles = false, anyProjected = false, anyDamped = false;
+  for (const ClothSettings& clothSettings : settings_.cloths) {
+    cloths_.push_back(makeCloth(clothSettings, model));
+    const Cloth& cloth = cloths_.back();
+    anyTriangles = anyTriangles || !cloth.rest.triangles.empty();
+    for (ConstraintKind kind : kConstraintKinds) {
+      if (cloth.rest.of(kind).empty()) continue;
+      anyProjected = anyProjected || clothSettings.material(kind).stiffness > 0.0f;
+      anyDamped = anyDamped || clothSettings.material(kind).damping > 0.0f;
+    }
+  }
+  scratch_.resize(cloths_.size());
+
+  const auto add = [this](Stage stage, bool perSubstep) { profile_.push_back({stage, perSubstep}); };
+  if (model == Model::position) {
+    if (settings_.air.pressure > 0.0f && anyTriangles) add(Stage::windPressure, true);
+    add(Stage::verletIntegrate, true);
+    if (anyProjected && settings_.solver.iterations > 0) add(Stage::projectConstraints, true);
+    if (anyDamped) add(Stage::dampConstraints, true);
+  } else {
+    add(integratorStage(settings_.solver.integrator), true);
+  }
+  add(Stage::guard, false);
+}
+
+bool World::hasStage(Stage stage) const {
+  for (const StageTiming& timing : profile_) {
+    if (timing.stage == stage) return true;
+  }
+  return false;
+}
+
+Vec3 World::velocity(int cloth, ParticleIndex particle) const {
+  const ParticleState& s = cloths_.at(static_cast<std::size_t>(cloth)).state;
+  if (!s.velocity.empty()) return s.velocity.at(particle);
+  return (s.position.at(particle) - s.previousPosition.at(particle)) / static_cast<float>(substepDt());
+}
+
+void World::startHistory() {
+  const float h = static_cast<float>(substepDt());
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    if (settings_.solver.model == Model::position) {
+      if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(cloths_[c].state.position.size(), Vec3{0.0f});
+      position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity, h);
+    } else {
+      force::startHistory(cloths_[c], settings_, h, scratch_[c]);
+    }
+  }
+  historyStarted_ = true;
+}
+
+void World::runStage(Stage stage) {
+  const float h = static_cast<float>(substepDt());
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    Cloth& cloth = cloths_[c];
+    SolverScratch& scratch = scratch_[c];
+    switch (stage) {
+      case Stage::windPressure: position::accumulateWindPressure(cloth, settings_.air, h, scratch.acceleration); break;
+      case Stage::verletIntegrate:
+        position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration);
+        break;
+      case Stage::projectConstraints: position::projectConstraints(cloth, settings_.solver.iterations); break;
+      case Stage::dampConstraints: position::dampConstraints(cloth); break;
+      case Stage::explicitEuler:
+      case Stage::symplecticEuler:
+      case Stage::verletForces:
+      case Stage::midpoint:
+      case Stage::rk4: force::step(settings_.solver.integrator, cloth, settings_, h, scratch); break;
+      case Stage::guard: break;
+    }
+  }
+}
+
+std::optional<Divergence> World::findBadParticle() const {
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    const ParticleState& s = cloths_[c].state;
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+      const Vec3 x = s.position[i];
+      const bool bad = !finite(x) || !(glm::abs(x.x) <= kRunawayDistance && glm::abs(x.y) <= kRunawayDistance &&
+                                       glm::abs(x.z) <= kRunawayDistance) ||
+                       (!s.velocity.empty() && !finite(s.velocity[i])) || !finite(s.previousPosition[i]);
+      if (bad) return Divergence{stepCount_ + 1, static_cast<int>(c), static_cast<ParticleIndex>(i)};
+    }
+  }
+  return std::nullopt;
+}
+
+StepStatus World::step() {
+  using Clock = std::chrono::steady_clock;
+  if (divergence_) return StepStatus::diverged;
+  if (!historyStarted_) startHistory();
+  lastGood_.resize(cloths_.size());
+  for (std::size_t c = 0; c < cloths_.size(); ++c) lastGood_[c] = cloths_[c].state;
+
+  for (StageTiming& timing : profile_) timing.lastSeconds = 0.0;
+  for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
+    for (StageTiming& timing : profile_) {
+      if (!timing.perSubstep) continue;
+      const auto start = Clock::now();
+      runStage(timing.stage);
+      timing.lastSeconds += std::chrono::duration<double>(Clock::now() - start).count();
+    }
+  }
+  for (StageTiming& timing : profile_) {
+    if (timing.perSubstep) continue;
+    const auto start = Clock::now();
+    if (timing.stage == Stage::guard) divergence_ = findBadParticle();
+    timing.lastSeconds += std::chrono::duration<double>(Clock::now() - start).count();
+  }
+  for (StageTiming& timing : profile_) timing.totalSeconds += timing.lastSeconds;
+
+  if (divergence_) {
+    for (std::size_t c = 0; c < cloths_.size(); ++c) cloths_[c].state = lastGood_[c];
+    return StepStatus::diverged;
+  }
+  ++stepCount_;
+  return StepStatus::ok;
+}
+
+StepStatus World::run(std::int64_t steps) {
+  for (std::int64_t i = 0; i < steps; ++i) {
+    if (step() == StepStatus::diverged) return StepStatus::diverged;
+  }
+  return StepStatus::ok;
+}
+
+}  // namespace drape::sim

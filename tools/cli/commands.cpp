@@ -1,0 +1,191 @@
+#include "commands.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/scene/error.hpp"
+#include "drape/scene/output.hpp"
+#include "drape/scene/scene.hpp"
+#include "drape/sim/metrics.hpp"
+#include "drape/sim/world.hpp"
+
+namespace drape::cli {
+
+namespace {
+
+int badInput(const std::string& message) {
+  std::cerr << "drape-cli: error: " << message << "\n";
+  return kExitBadInput;
+}
+
+scene::Scene load(const SceneArguments& arguments) {
+  return scene::loadScene(scene::resolveScenePath(arguments.scene), arguments.overrides);
+}
+
+std::size_t countConstraints(const sim::World& world) {
+  std::size_t count = 0;
+  for (const sim::Cloth& cloth : world.cloths()) {
+    for (const auto& list : cloth.rest.constraints) count += list.size();
+  }
+  return count;
+}
+
+std::size_t countParticles(const sim::World& world) {
+  std::size_t count = 0;
+  for (const sim::Cloth& cloth : world.cloths()) count += cloth.rest.particleCount();
+  return count;
+}
+
+// The engine validates too; its messages are a last line of defence behind the scene reader's.
+sim::World makeWorld(const scene::Scene& scene) {
+  try {
+    return sim::World(scene.world);
+  } catch (const std::invalid_argument& error) {
+    throw scene::InputError(scene.source + ": " + error.what());
+  }
+}
+
+enum class OutputKind { state, mesh };
+
+OutputKind outputKind(const std::string& file) {
+  const std::string extension = std::filesystem::path(file).extension().string();
+  if (extension == ".json") return OutputKind::state;
+  if (extension == ".obj") return OutputKind::mesh;
+  throw scene::InputError("--out " + file + ": expected a file ending in .json (state) or .obj (mesh)");
+}
+
+struct TraceTarget {
+  int cloth;
+  sim::ParticleIndex particle;
+};
+
+TraceTarget traceTarget(const std::string& text, int cloth, const sim::World& world) {
+  const std::string where = "--trace " + text;
+  int column = -1, row = -1;
+  const std::size_t comma = text.find(',');
+  const auto parse = [](std::string_view part, int& value) {
+    const auto [end, error] = std::from_chars(part.data(), part.data() + part.size(), value);
+    return error == std::errc{} && end == part.data() + part.size();
+  };
+  if (comma == std::string::npos || !parse(std::string_view(text).substr(0, comma), column) ||
+      !parse(std::string_view(text).substr(comma + 1), row)) {
+    throw scene::InputError(where + ": expected column,row (two integers)");
+  }
+  if (cloth >= static_cast<int>(world.cloths().size())) {
+    throw scene::InputError("--trace-cloth " + std::to_string(cloth) + ": the scene has " +
+                            std::to_string(world.cloths().size()) + " cloth(s)");
+  }
+  const sim::ClothRest& rest = world.cloths()[static_cast<std::size_t>(cloth)].rest;
+  if (column < 0 || column >= rest.columns || row < 0 || row >= rest.rows) {
+    throw scene::InputError(where + ": outside the " + std::to_string(rest.columns) + " x " +
+                            std::to_string(rest.rows) + " grid of cloth " + std::to_string(cloth));
+  }
+  return {cloth, rest.index(column, row)};
+}
+
+void appendTraceRow(std::ostringstream& csv, const sim::World& world, const TraceTarget& target) {
+  const sim::Vec3 x = world.cloths()[static_cast<std::size_t>(target.cloth)].state.position[target.particle];
+  csv << world.time() << ',' << x.x << ',' << x.y << ',' << x.z << '\n';
+}
+
+}  // namespace
+
+int validate(const SceneArguments& arguments) {
+  try {
+    const scene::Scene scene = load(arguments);
+    const sim::World world = makeWorld(scene);
+    std::cout << scene.source << ": ok: \"" << scene.name << "\", " << world.cloths().size() << " cloth(s), "
+              << countParticles(world) << " particles, " << countConstraints(world) << " constraints, "
+              << sim::name(scene.world.solver.model) << " model\n";
+    return kExitOk;
+  } catch (const scene::InputError& error) {
+    return badInput(error.what());
+  }
+}
+
+int run(const RunArguments& arguments) {
+  try {
+    const scene::Scene scene = load(arguments.input);
+    sim::World world = makeWorld(scene);
+    for (const std::string& file : arguments.outputs) outputKind(file);  // reject before running
+    const double dt = scene.world.solver.dt;
+    const std::int64_t steps = arguments.steps ? *arguments.steps
+                                               : static_cast<std::int64_t>(std::ceil(
+                                                     (arguments.seconds ? *arguments.seconds : scene.duration) / dt - 1e-9));
+
+    std::optional<TraceTarget> target;
+    std::ostringstream trace;
+    trace.precision(9);
+    if (arguments.trace) {
+      target = traceTarget(*arguments.trace, arguments.traceCloth, world);
+      trace << "time,x,y,z\n";
+      appendTraceRow(trace, world, *target);
+    }
+
+    const auto start = std::chrono::steady_clock::now();
+    for (std::int64_t i = 0; i < steps; ++i) {
+      if (world.step() == sim::StepStatus::diverged) {
+        const sim::Divergence& d = *world.divergence();
+        std::cerr << "drape-cli: error: " << scene.source << ": diverged at step " << d.step << " (t = "
+                  << static_cast<double>(d.step) * dt << " s): cloth " << d.cloth << " particle " << d.particle
+                  << " became non-finite or ran away past " << sim::kRunawayDistance << " m; nothing written\n";
+        return kExitDiverged;
+      }
+      if (target) appendTraceRow(trace, world, *target);
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    std::vector<std::string> written;
+    for (const std::string& file : arguments.outputs) {
+      if (outputKind(file) == OutputKind::state) {
+        scene::writeFileAtomically(file, scene::stateDocument(scene, world).dump(1) + "\n");
+      } else {
+        scene::writeFileAtomically(file, scene::objText(world));
+      }
+      written.push_back(file);
+    }
+    if (arguments.traceOut) {
+      scene::writeFileAtomically(*arguments.traceOut, trace.str());
+      written.push_back(*arguments.traceOut);
+    }
+
+    if (!arguments.quiet) {
+      const sim::StrainStats strain = sim::structuralStrain(world);
+      const sim::Energy energy = sim::energy(world);
+      std::printf("%s: %lld steps (%.3f s simulated) in %.3f s; %zu particles; structural strain max %.2f %%, mean %.3f %%; energy %.4g J\n",
+                  scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds,
+                  countParticles(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
+      for (const std::string& file : written) std::printf("wrote %s\n", file.c_str());
+    }
+    return kExitOk;
+  } catch (const scene::InputError& error) {
+    return badInput(error.what());
+  }
+}
+
+int listScenes() {
+  std::vector<std::filesystem::path> files;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(scene::sceneDirectory(), error)) {
+    if (entry.path().extension() == ".json") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  for (const auto& file : files) {
+    try {
+      const scene::Scene scene = scene::loadScene(file);
+      std::printf("%-20s %s\n", file.stem().string().c_str(), scene.description.c_str());
+    } catch (const scene::InputError& e) {
+      std::printf("%-20s (invalid: %s)\n", file.stem().string().c_str(), e.what());
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace drape::cli

@@ -1,0 +1,36 @@
+// drape-cli's subcommands. Each returns the process exit code:
+//   0 success, 1 the simulation diverged, 2 bad input (scene, option, unwritable output).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace drape::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitDiverged = 1;
+inline constexpr int kExitBadInput = 2;
+
+struct SceneArguments {
+  std::string scene;                  // path, or the name of a shipped scene
+  std::vector<std::string> overrides;  // --set path=value
+};
+
+struct RunArguments {
+  SceneArguments input;
+  std::optional<std::int64_t> steps;
+  std::optional<double> seconds;
+  std::vector<std::string> outputs;  // .json (state) or .obj (mesh)
+  std::optional<std::string> trace;  // "column,row"
+  int traceCloth = 0;
+  std::optional<std::string> traceOut;
+  bool quiet = false;
+};
+
+int validate(const SceneArguments& arguments);
+int run(const RunArguments& arguments);
+int listScenes();
+
+}  // namespace drape::cli

@@ -1,0 +1,51 @@
+// drape-cli: runs the Drape engine without a window. `drape-cli --help` lists the subcommands.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  using namespace drape::cli;
+  CLI::App app{"drape-cli: the Drape cloth engine, headless"};
+  app.require_subcommand(1);
+
+  SceneArguments validateArguments;
+  CLI::App* validateCommand = app.add_subcommand("validate", "Check a scene file; exit 0 if it is valid, 2 if not");
+  validateCommand->add_option("scene", validateArguments.scene, "Scene file, or the name of a shipped scene")->required();
+  validateCommand->add_option("--set", validateArguments.overrides, "Override a key: path=value (repeatable)");
+
+  RunArguments runArguments;
+  CLI::App* runCommand = app.add_subcommand("run", "Simulate a scene and write its final state, mesh or a trace");
+  runCommand->add_option("scene", runArguments.input.scene, "Scene file, or the name of a shipped scene")->required();
+  runCommand->add_option("--set", runArguments.input.overrides, "Override a key: path=value (repeatable)");
+  CLI::Option* steps =
+      runCommand->add_option("--steps", runArguments.steps, "Number of steps (default: the scene's duration)")
+          ->check(CLI::Range(std::int64_t{0}, std::int64_t{1000000000}));
+  runCommand->add_option("--time", runArguments.seconds, "Simulated seconds instead of --steps")
+      ->check(CLI::Range(0.0, 1.0e6))
+      ->excludes(steps);
+  runCommand->add_option("--out", runArguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
+  CLI::Option* trace = runCommand->add_option("--trace", runArguments.trace, "Trace one particle: column,row");
+  runCommand->add_option("--trace-cloth", runArguments.traceCloth, "Which cloth --trace refers to (default 0)")
+      ->check(CLI::Range(0, 1000))
+      ->needs(trace);
+  CLI::Option* traceOut =
+      runCommand->add_option("--trace-out", runArguments.traceOut, "CSV file for --trace: time and position per step");
+  trace->needs(traceOut);
+  traceOut->needs(trace);
+  runCommand->add_flag("--quiet", runArguments.quiet, "Print nothing on success");
+
+  app.add_subcommand("scenes", "List the shipped scenes");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    if (error.get_exit_code() == 0) return app.exit(error);  // --help
+    std::cerr << "drape-cli: error: " << error.what() << " (see drape-cli --help)\n";
+    return kExitBadInput;
+  }
+  if (*validateCommand) return validate(validateArguments);
+  if (*runCommand) return run(runArguments);
+  return listScenes();
+}
