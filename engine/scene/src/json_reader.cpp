@@ -94,7 +94,7 @@ sim::Vec3 readVec3(const nlohmann::json& value, const std::string& path, const s
     const nlohmann::json& component = value[static_cast<std::size_t>(i)];
     const double x = component.is_number() ? component.get<double>() : NAN;
     if (!std::isfinite(x) || std::abs(x) > maxAbs) failAt(source, path, expected.str(), &value);
-    v[i] = static_cast<float>(x);
+    v[i] = x;
   }
   return v;
 }

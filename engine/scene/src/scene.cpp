@@ -27,15 +27,15 @@ constexpr double kMaxCoordinate = 1.0e4;  // m
 KindMaterial defaultMaterial(Model model, ConstraintKind kind) {
   if (model == Model::position) {
     switch (kind) {
-      case ConstraintKind::stretch: return {1.0f, 0.0f};
-      case ConstraintKind::shear: return {1.0f, 0.0f};
-      case ConstraintKind::bend: return {0.2f, 0.0f};
+      case ConstraintKind::stretch: return {1.0, 0.0};
+      case ConstraintKind::shear: return {1.0, 0.0};
+      case ConstraintKind::bend: return {0.2, 0.0};
     }
   }
   switch (kind) {
-    case ConstraintKind::stretch: return {2000.0f, 1.0f};
-    case ConstraintKind::shear: return {2000.0f, 1.0f};
-    case ConstraintKind::bend: return {200.0f, 0.1f};
+    case ConstraintKind::stretch: return {2000.0, 1.0};
+    case ConstraintKind::shear: return {2000.0, 1.0};
+    case ConstraintKind::bend: return {200.0, 0.1};
   }
   return {};
 }
@@ -46,11 +46,11 @@ KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model)
   if (!cloth.has(key)) return material;
   ObjectReader reader = cloth.object(key);
   if (model == Model::position) {
-    material.stiffness = static_cast<float>(reader.number("stiffness", material.stiffness, {0.0, 1.0, false, "fraction corrected per sweep"}));
-    material.damping = static_cast<float>(reader.number("damping", material.damping, {0.0, 1.0, false, "fraction of relative velocity removed per substep"}));
+    material.stiffness = reader.number("stiffness", material.stiffness, {0.0, 1.0, false, "fraction corrected per sweep"});
+    material.damping = reader.number("damping", material.damping, {0.0, 1.0, false, "fraction of relative velocity removed per substep"});
   } else {
-    material.stiffness = static_cast<float>(reader.number("stiffness", material.stiffness, {0.0, 1.0e9, false, "N/m"}));
-    material.damping = static_cast<float>(reader.number("damping", material.damping, {0.0, 1.0e6, false, "N s/m"}));
+    material.stiffness = reader.number("stiffness", material.stiffness, {0.0, 1.0e9, false, "N/m"});
+    material.damping = reader.number("damping", material.damping, {0.0, 1.0e6, false, "N s/m"});
   }
   reader.finish();
   return material;
@@ -62,8 +62,8 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
   sim::LatticeSpec& lattice = cloth.lattice;
   lattice.columns = grid.integer("columns", 2, 1, sim::kMaxLatticeSide);
   lattice.rows = grid.integer("rows", 2, 1, sim::kMaxLatticeSide);
-  lattice.width = static_cast<float>(grid.number("width", 1.0, {0.0, 1000.0, true, "m"}));
-  lattice.height = static_cast<float>(grid.number("height", 1.0, {0.0, 1000.0, true, "m"}));
+  lattice.width = grid.number("width", 1.0, {0.0, 1000.0, true, "m"});
+  lattice.height = grid.number("height", 1.0, {0.0, 1000.0, true, "m"});
   const long long particles = static_cast<long long>(lattice.columns) * lattice.rows;
   if (particles > particleBudget) {
     throw InputError(reader.source() + ": " + reader.pathOf("grid") + ": " + std::to_string(lattice.columns) +
@@ -73,9 +73,10 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
   particleBudget -= particles;
   grid.finish();
 
-  lattice.origin = reader.vec3("origin", sim::Vec3{0.0f}, kMaxCoordinate, "m");
+  lattice.origin = reader.vec3("origin", sim::Vec3{0.0}, kMaxCoordinate, "m");
   lattice.plane = reader.choice("plane", "xz", {"xz", "xy"}) == "xz" ? sim::LatticePlane::xz : sim::LatticePlane::xy;
-  cloth.mass = static_cast<float>(reader.number("mass", 1.0, {0.0, 1.0e6, true, "kg"}));
+  cloth.mass = reader.number("mass", 1.0, {0.0, 1.0e6, true, "kg"});
+  cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
   for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model);
 
   const json& pins = reader.array("pins", kMaxPins);
@@ -92,7 +93,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
                     particle[1].get<long long>() < lattice.rows;
     if (!ok) pin.fail("particle", expected, &particle);
     sim::Pin result{particle[0].get<int>(), particle[1].get<int>(), std::nullopt};
-    if (pin.has("position")) result.position = pin.vec3("position", sim::Vec3{0.0f}, kMaxCoordinate, "m");
+    if (pin.has("position")) result.position = pin.vec3("position", sim::Vec3{0.0}, kMaxCoordinate, "m");
     pin.finish();
     cloth.pins.push_back(result);
   }
@@ -123,15 +124,15 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.dt = solver.number("dt", world.solver.dt, {0.0, 1.0, true, "s"});
     world.solver.substeps = solver.integer("substeps", world.solver.substeps, 1, sim::kMaxSubsteps);
     world.solver.iterations = solver.integer("iterations", world.solver.iterations, 0, sim::kMaxIterations);
-    world.solver.damping = static_cast<float>(solver.number("damping", 0.0, {0.0, 1000.0, false, "1/s"}));
+    world.solver.damping = solver.number("damping", 0.0, {0.0, 1000.0, false, "1/s"});
     solver.finish();
   }
   world.gravity = root.vec3("gravity", world.gravity, 1000.0, "m/s^2");
   if (root.has("wind")) {
     ObjectReader wind = root.object("wind");
-    world.air.velocity = wind.vec3("velocity", sim::Vec3{0.0f}, 1000.0, "m/s");
-    world.air.drag = static_cast<float>(wind.number("drag", 0.0, {0.0, 1000.0, false, "1/s"}));
-    world.air.pressure = static_cast<float>(wind.number("pressure", 0.0, {0.0, 1.0e4, false, "kg/(m^2 s)"}));
+    world.air.velocity = wind.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
+    world.air.drag = wind.number("drag", 0.0, {0.0, 1000.0, false, "1/s"});
+    world.air.pressure = wind.number("pressure", 0.0, {0.0, 1.0e4, false, "kg/(m^2 s)"});
     wind.finish();
   }
   const json& cloths = root.array("cloths", kMaxCloths);

@@ -29,7 +29,7 @@ std::string_view name(LatticePlane plane) {
 namespace {
 
 void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
-  const float restLength = glm::length(rest.restPositions[b] - rest.restPositions[a]);
+  const Real restLength = glm::length(rest.restPositions[b] - rest.restPositions[a]);
   rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
 }
 
@@ -42,24 +42,24 @@ ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
     throw std::invalid_argument("lattice of " + std::to_string(spec.columns) + " x " +
                                 std::to_string(spec.rows) + " particles is outside the limits");
   }
-  if (!(spec.width > 0.0f) || !(spec.height > 0.0f)) {
+  if (!(spec.width > 0.0) || !(spec.height > 0.0)) {
     throw std::invalid_argument("lattice width and height must be positive");
   }
 
   ClothRest rest;
   rest.columns = spec.columns;
   rest.rows = spec.rows;
-  const float dx = spec.columns > 1 ? spec.width / static_cast<float>(spec.columns - 1) : 0.0f;
-  const float dy = spec.rows > 1 ? spec.height / static_cast<float>(spec.rows - 1) : 0.0f;
+  const Real dx = spec.columns > 1 ? spec.width / static_cast<Real>(spec.columns - 1) : 0.0;
+  const Real dy = spec.rows > 1 ? spec.height / static_cast<Real>(spec.rows - 1) : 0.0;
   // Unit vectors of the lattice's column and row directions in the world.
-  const Vec3 along{1.0f, 0.0f, 0.0f};
-  const Vec3 down = spec.plane == LatticePlane::xz ? Vec3{0.0f, 0.0f, 1.0f} : Vec3{0.0f, -1.0f, 0.0f};
+  const Vec3 along{1.0, 0.0, 0.0};
+  const Vec3 down = spec.plane == LatticePlane::xz ? Vec3{0.0, 0.0, 1.0} : Vec3{0.0, -1.0, 0.0};
 
   rest.restPositions.reserve(static_cast<std::size_t>(spec.columns) * spec.rows);
   for (int row = 0; row < spec.rows; ++row) {
     for (int column = 0; column < spec.columns; ++column) {
-      rest.restPositions.push_back(spec.origin + along * (dx * static_cast<float>(column)) +
-                                   down * (dy * static_cast<float>(row)));
+      rest.restPositions.push_back(spec.origin + along * (dx * static_cast<Real>(column)) +
+                                   down * (dy * static_cast<Real>(row)));
     }
   }
 

@@ -4,37 +4,37 @@
 
 namespace drape::sim::force {
 
-Vec3 springForce(Vec3 x1, Vec3 x2, Vec3 v1, Vec3 v2, float restLength, float ks, float kd) {
+Vec3 springForce(Vec3 x1, Vec3 x2, Vec3 v1, Vec3 v2, Real restLength, Real ks, Real kd) {
   const Vec3 dx = x1 - x2;
-  const float length = glm::length(dx);
-  if (!(length > 1e-10f)) return Vec3{0.0f};
+  const Real length = glm::length(dx);
+  if (!(length > 1e-10)) return Vec3{0.0};
   const Vec3 direction = dx / length;
   return -(ks * (length - restLength) + kd * glm::dot(v1 - v2, direction)) * direction;
 }
 
 void accelerations(const Cloth& cloth, const WorldSettings& world, const std::vector<Vec3>& x,
                    const std::vector<Vec3>& v, std::vector<Vec3>& a) {
-  const std::vector<float>& w = cloth.state.inverseMass;
+  const std::vector<Real>& w = cloth.state.inverseMass;
   const AirSettings& air = world.air;
-  const float linearDamping = world.solver.damping + air.drag;
+  const Real linearDamping = world.solver.damping + air.drag;
   const Vec3 constant = world.gravity + air.drag * air.velocity;
   // External accelerations first (a = f / m with f proportional to m), then forces times 1/m.
   for (std::size_t i = 0; i < x.size(); ++i) {
-    a[i] = w[i] > 0.0f ? constant - linearDamping * v[i] : Vec3{0.0f};
+    a[i] = w[i] > 0.0 ? constant - linearDamping * v[i] : Vec3{0.0};
   }
-  if (air.pressure > 0.0f) {
+  if (air.pressure > 0.0) {
     for (const glm::uvec3& t : cloth.rest.triangles) {
       const Vec3 doubleAreaNormal = glm::cross(x[t.y] - x[t.x], x[t.z] - x[t.x]);
-      const float doubleArea = glm::length(doubleAreaNormal);
-      if (!(doubleArea > 0.0f)) continue;
-      const Vec3 velocity = (v[t.x] + v[t.y] + v[t.z]) / 3.0f;
-      const Vec3 force = doubleAreaNormal * (air.pressure * 0.5f * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
-      for (int corner = 0; corner < 3; ++corner) a[t[corner]] += force * (w[t[corner]] / 3.0f);
+      const Real doubleArea = glm::length(doubleAreaNormal);
+      if (!(doubleArea > 0.0)) continue;
+      const Vec3 velocity = (v[t.x] + v[t.y] + v[t.z]) / 3.0;
+      const Vec3 force = doubleAreaNormal * (air.pressure * 0.5 * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
+      for (int corner = 0; corner < 3; ++corner) a[t[corner]] += force * (w[t[corner]] / 3.0);
     }
   }
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);
-    if (material.stiffness == 0.0f && material.damping == 0.0f) continue;
+    if (material.stiffness == 0.0 && material.damping == 0.0) continue;
     for (const DistanceConstraint& c : cloth.rest.of(kind)) {
       const Vec3 f = springForce(x[c.a], x[c.b], v[c.a], v[c.b], c.restLength, material.stiffness, material.damping);
       a[c.a] += w[c.a] * f;
@@ -45,9 +45,9 @@ void accelerations(const Cloth& cloth, const WorldSettings& world, const std::ve
 
 namespace {
 
-void resize(std::vector<Vec3>& array, std::size_t n) { array.assign(n, Vec3{0.0f}); }
+void resize(std::vector<Vec3>& array, std::size_t n) { array.assign(n, Vec3{0.0}); }
 
-void explicitEuler(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scratch) {
+void explicitEuler(Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   accelerations(cloth, world, s.position, s.velocity, scratch.acceleration);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
@@ -56,7 +56,7 @@ void explicitEuler(Cloth& cloth, const WorldSettings& world, float h, SolverScra
   }
 }
 
-void symplecticEuler(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scratch) {
+void symplecticEuler(Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   accelerations(cloth, world, s.position, s.velocity, scratch.acceleration);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
@@ -66,26 +66,26 @@ void symplecticEuler(Cloth& cloth, const WorldSettings& world, float h, SolverSc
 }
 
 // Stormer-Verlet on positions; velocity-dependent forces see the backward difference (x - x_prev)/h.
-void verlet(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scratch) {
+void verlet(Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
-  const float inverseH = 1.0f / h;
+  const Real inverseH = 1.0 / h;
   for (std::size_t i = 0; i < s.position.size(); ++i) s.velocity[i] = (s.position[i] - s.previousPosition[i]) * inverseH;
   accelerations(cloth, world, s.position, s.velocity, scratch.acceleration);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
     const Vec3 x = s.position[i];
-    s.position[i] = 2.0f * x - s.previousPosition[i] + scratch.acceleration[i] * (h * h);
+    s.position[i] = 2.0 * x - s.previousPosition[i] + scratch.acceleration[i] * (h * h);
     s.previousPosition[i] = x;
     s.velocity[i] = (s.position[i] - x) * inverseH;
   }
 }
 
-void midpoint(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scratch) {
+void midpoint(Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   const std::size_t n = s.position.size();
   accelerations(cloth, world, s.position, s.velocity, scratch.acceleration);
   for (std::size_t i = 0; i < n; ++i) {
-    scratch.trialPosition[i] = s.position[i] + s.velocity[i] * (0.5f * h);
-    scratch.trialVelocity[i] = s.velocity[i] + scratch.acceleration[i] * (0.5f * h);
+    scratch.trialPosition[i] = s.position[i] + s.velocity[i] * (0.5 * h);
+    scratch.trialVelocity[i] = s.velocity[i] + scratch.acceleration[i] * (0.5 * h);
   }
   accelerations(cloth, world, scratch.trialPosition, scratch.trialVelocity, scratch.acceleration);
   for (std::size_t i = 0; i < n; ++i) {
@@ -96,7 +96,7 @@ void midpoint(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& 
 
 // Classical RK4 on the first-order system (x, v)' = (v, a(x, v)), keeping running sums so only
 // five scratch arrays are needed.
-void rk4(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scratch) {
+void rk4(Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   const std::size_t n = s.position.size();
   std::vector<Vec3>& a = scratch.acceleration;
@@ -106,33 +106,33 @@ void rk4(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scrat
   for (std::size_t i = 0; i < n; ++i) {
     scratch.sumPosition[i] = s.velocity[i];
     scratch.sumVelocity[i] = a[i];
-    xt[i] = s.position[i] + s.velocity[i] * (0.5f * h);
-    vt[i] = s.velocity[i] + a[i] * (0.5f * h);
+    xt[i] = s.position[i] + s.velocity[i] * (0.5 * h);
+    vt[i] = s.velocity[i] + a[i] * (0.5 * h);
   }
   accelerations(cloth, world, xt, vt, a);  // k2
   for (std::size_t i = 0; i < n; ++i) {
-    scratch.sumPosition[i] += 2.0f * vt[i];
-    scratch.sumVelocity[i] += 2.0f * a[i];
-    xt[i] = s.position[i] + vt[i] * (0.5f * h);
-    vt[i] = s.velocity[i] + a[i] * (0.5f * h);
+    scratch.sumPosition[i] += 2.0 * vt[i];
+    scratch.sumVelocity[i] += 2.0 * a[i];
+    xt[i] = s.position[i] + vt[i] * (0.5 * h);
+    vt[i] = s.velocity[i] + a[i] * (0.5 * h);
   }
   accelerations(cloth, world, xt, vt, a);  // k3
   for (std::size_t i = 0; i < n; ++i) {
-    scratch.sumPosition[i] += 2.0f * vt[i];
-    scratch.sumVelocity[i] += 2.0f * a[i];
+    scratch.sumPosition[i] += 2.0 * vt[i];
+    scratch.sumVelocity[i] += 2.0 * a[i];
     xt[i] = s.position[i] + vt[i] * h;
     vt[i] = s.velocity[i] + a[i] * h;
   }
   accelerations(cloth, world, xt, vt, a);  // k4
   for (std::size_t i = 0; i < n; ++i) {
-    s.position[i] += (scratch.sumPosition[i] + vt[i]) * (h / 6.0f);
-    s.velocity[i] += (scratch.sumVelocity[i] + a[i]) * (h / 6.0f);
+    s.position[i] += (scratch.sumPosition[i] + vt[i]) * (h / 6.0);
+    s.velocity[i] += (scratch.sumVelocity[i] + a[i]) * (h / 6.0);
   }
 }
 
 }  // namespace
 
-void startHistory(Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scratch) {
+void startHistory(Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   const std::size_t n = cloth.state.position.size();
   resize(scratch.acceleration, n);
   const Integrator integrator = world.solver.integrator;
@@ -149,11 +149,11 @@ void startHistory(Cloth& cloth, const WorldSettings& world, float h, SolverScrat
   ParticleState& s = cloth.state;
   accelerations(cloth, world, s.position, s.velocity, scratch.acceleration);
   for (std::size_t i = 0; i < n; ++i) {
-    s.previousPosition[i] = s.position[i] - s.velocity[i] * h + scratch.acceleration[i] * (0.5f * h * h);
+    s.previousPosition[i] = s.position[i] - s.velocity[i] * h + scratch.acceleration[i] * (0.5 * h * h);
   }
 }
 
-void step(Integrator integrator, Cloth& cloth, const WorldSettings& world, float h, SolverScratch& scratch) {
+void step(Integrator integrator, Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   switch (integrator) {
     case Integrator::explicitEuler: explicitEuler(cloth, world, h, scratch); break;
     case Integrator::symplecticEuler: symplecticEuler(cloth, world, h, scratch); break;

@@ -13,7 +13,7 @@ StrainStats structuralStrain(const World& world) {
   double sumAbs = 0.0;
   for (const Cloth& cloth : world.cloths()) {
     for (const DistanceConstraint& c : cloth.rest.of(ConstraintKind::stretch)) {
-      if (!(c.restLength > 0.0f)) continue;
+      if (!(c.restLength > 0.0)) continue;
       const double strain =
           static_cast<double>(glm::length(cloth.state.position[c.b] - cloth.state.position[c.a])) / c.restLength - 1.0;
       stats.max = std::max(stats.max, strain);
@@ -36,7 +36,7 @@ Energy energy(const World& world) {
     const Cloth& cloth = world.cloths()[c];
     const double m = cloth.particleMass;
     for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-      if (cloth.state.inverseMass[i] == 0.0f) continue;  // pinned: held by the world, no energy of its own
+      if (cloth.state.inverseMass[i] == 0.0) continue;  // pinned: held by the world, no energy of its own
       const Vec3 v = world.velocity(static_cast<int>(c), static_cast<ParticleIndex>(i));
       e.kinetic += 0.5 * m * static_cast<double>(glm::dot(v, v));
       e.gravitational -= m * static_cast<double>(glm::dot(g, cloth.state.position[i]));
@@ -56,7 +56,7 @@ Energy energy(const World& world) {
 
 std::vector<Vec3> vertexNormals(const Cloth& cloth) {
   const std::vector<Vec3>& x = cloth.state.position;
-  std::vector<Vec3> normals(x.size(), Vec3{0.0f});
+  std::vector<Vec3> normals(x.size(), Vec3{0.0});
   for (const glm::uvec3& t : cloth.rest.triangles) {
     const Vec3 n = glm::cross(x[t.y] - x[t.x], x[t.z] - x[t.x]);  // length = twice the area
     normals[t.x] += n;
@@ -64,10 +64,10 @@ std::vector<Vec3> vertexNormals(const Cloth& cloth) {
     normals[t.z] += n;
   }
   const Vec3 planeNormal =
-      cloth.settings.lattice.plane == LatticePlane::xz ? Vec3{0.0f, 1.0f, 0.0f} : Vec3{0.0f, 0.0f, 1.0f};
+      cloth.settings.lattice.plane == LatticePlane::xz ? Vec3{0.0, 1.0, 0.0} : Vec3{0.0, 0.0, 1.0};
   for (Vec3& n : normals) {
-    const float length = glm::length(n);
-    n = length > 0.0f ? n / length : planeNormal;
+    const Real length = glm::length(n);
+    n = length > 0.0 ? n / length : planeNormal;
   }
   return normals;
 }

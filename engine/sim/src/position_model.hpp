@@ -12,17 +12,19 @@ namespace drape::sim::position {
 // Verlet needs x_prev at t = -h. A Taylor start, x_prev = x - v0 h + a0 h^2 / 2, makes Verlet
 // reproduce x0 + v0 t + a t^2 / 2 exactly under constant acceleration; x_prev = x would instead
 // start the cloth with a spurious velocity of a h / 2.
-void startHistory(Cloth& cloth, Vec3 initialAcceleration, float h);
+void startHistory(Cloth& cloth, Vec3 initialAcceleration, Real h);
 
 // Adds the aerodynamic force on every triangle to `acceleration` (zeroed first):
 // f = pressure * area * ((wind - v) . n) n, shared equally by the triangle's three particles.
-void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, float h,
+void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h,
                             std::vector<Vec3>& acceleration);
 
-// x' = x + (x - x_prev) exp(-(damping + drag) h) + (g + drag wind + a_extra) h^2
-// The seed's Verlet step; the velocity term decays exactly as linear damping would, so no damping
-// or drag value can make it overshoot. Pinned particles (inverse mass 0) do not move.
-void integrate(Cloth& cloth, const WorldSettings& world, float h, const std::vector<Vec3>* extraAcceleration);
+// x' = x + (x - x_prev) e^{-kh} + a h^2 (1 - e^{-kh}) / (kh),  k = damping + drag,
+// a = g + drag wind + a_extra. With k = 0 this is the seed's Verlet step; with k > 0 it is the exact
+// solution of du/dt = a - k u over the substep, so no damping or drag can make it overshoot and a
+// falling particle reaches exactly the terminal velocity a / k. Pinned particles (inverse mass 0)
+// do not move.
+void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration);
 
 // `iterations` Gauss-Seidel sweeps over the stretch, shear and bend constraints. Each violated
 // constraint is corrected as the seed writes it, weighted by inverse mass and scaled by the kind's
@@ -36,7 +38,7 @@ void projectConstraints(Cloth& cloth, int iterations);
 void dampConstraints(Cloth& cloth);
 
 // One constraint, exposed for tests.
-void projectDistance(std::vector<Vec3>& position, const std::vector<float>& inverseMass,
-                     const DistanceConstraint& constraint, float stiffness);
+void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inverseMass,
+                     const DistanceConstraint& constraint, Real stiffness);
 
 }  // namespace drape::sim::position

@@ -15,7 +15,7 @@ namespace drape::sim {
 
 namespace {
 
-bool finite(float value) { return std::isfinite(value); }
+bool finite(Real value) { return std::isfinite(value); }
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 void require(bool condition, const std::string& what) {
@@ -27,21 +27,22 @@ void validate(const WorldSettings& s) {
   require(std::isfinite(solver.dt) && solver.dt > 0.0, "solver.dt must be a positive number of seconds");
   require(solver.substeps >= 1 && solver.substeps <= kMaxSubsteps, "solver.substeps is out of range");
   require(solver.iterations >= 0 && solver.iterations <= kMaxIterations, "solver.iterations is out of range");
-  require(finite(solver.damping) && solver.damping >= 0.0f, "solver.damping must be finite and >= 0");
+  require(finite(solver.damping) && solver.damping >= 0.0, "solver.damping must be finite and >= 0");
   require(finite(s.gravity), "gravity must be finite");
   require(finite(s.air.velocity), "wind velocity must be finite");
-  require(finite(s.air.drag) && s.air.drag >= 0.0f, "wind drag must be finite and >= 0");
-  require(finite(s.air.pressure) && s.air.pressure >= 0.0f, "wind pressure must be finite and >= 0");
+  require(finite(s.air.drag) && s.air.drag >= 0.0, "wind drag must be finite and >= 0");
+  require(finite(s.air.pressure) && s.air.pressure >= 0.0, "wind pressure must be finite and >= 0");
   long long particles = 0;
   for (const ClothSettings& cloth : s.cloths) {
     particles += static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
-    require(finite(cloth.mass) && cloth.mass > 0.0f, "cloth mass must be positive");
+    require(finite(cloth.mass) && cloth.mass > 0.0, "cloth mass must be positive");
     require(finite(cloth.lattice.origin), "cloth origin must be finite");
+    require(finite(cloth.initialVelocity), "cloth velocity must be finite");
     for (const KindMaterial& m : cloth.materials) {
-      require(finite(m.stiffness) && m.stiffness >= 0.0f && finite(m.damping) && m.damping >= 0.0f,
+      require(finite(m.stiffness) && m.stiffness >= 0.0 && finite(m.damping) && m.damping >= 0.0,
               "constraint stiffness and damping must be finite and >= 0");
       if (solver.model == Model::position) {
-        require(m.stiffness <= 1.0f && m.damping <= 1.0f, "position-model stiffness and damping must be in 0..1");
+        require(m.stiffness <= 1.0 && m.damping <= 1.0, "position-model stiffness and damping must be in 0..1");
       }
     }
     for (const Pin& pin : cloth.pins) {
@@ -53,7 +54,7 @@ void validate(const WorldSettings& s) {
   require(particles <= kMaxParticles, "too many particles");
 }
 
-bool used(const KindMaterial& m) { return m.stiffness > 0.0f || m.damping > 0.0f; }
+bool used(const KindMaterial& m) { return m.stiffness > 0.0 || m.damping > 0.0; }
 
 Stage integratorStage(Integrator integrator) {
   switch (integrator) {
@@ -73,17 +74,22 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
                                                used(settings.material(ConstraintKind::shear)),
                                                used(settings.material(ConstraintKind::bend))});
   const std::size_t n = cloth.rest.particleCount();
-  cloth.particleMass = settings.mass / static_cast<float>(n);
+  cloth.particleMass = settings.mass / static_cast<Real>(n);
   ParticleState& s = cloth.state;
   s.position = cloth.rest.restPositions;
-  s.inverseMass.assign(n, 1.0f / cloth.particleMass);
+  s.inverseMass.assign(n, 1.0 / cloth.particleMass);
   for (const Pin& pin : settings.pins) {
     const ParticleIndex p = cloth.rest.index(pin.column, pin.row);
-    s.inverseMass[p] = 0.0f;
+    s.inverseMass[p] = 0.0;
     if (pin.position) s.position[p] = *pin.position;
   }
   s.previousPosition = s.position;
-  if (model == Model::force) s.velocity.assign(n, Vec3{0.0f});
+  if (model == Model::force) {
+    s.velocity.assign(n, settings.initialVelocity);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (s.inverseMass[i] == 0.0) s.velocity[i] = Vec3{0.0};
+    }
+  }
   return cloth;
 }
 
@@ -99,15 +105,15 @@ World::World(WorldSettings settings) : settings_(std::move(settings)) {
     anyTriangles = anyTriangles || !cloth.rest.triangles.empty();
     for (ConstraintKind kind : kConstraintKinds) {
       if (cloth.rest.of(kind).empty()) continue;
-      anyProjected = anyProjected || clothSettings.material(kind).stiffness > 0.0f;
-      anyDamped = anyDamped || clothSettings.material(kind).damping > 0.0f;
+      anyProjected = anyProjected || clothSettings.material(kind).stiffness > 0.0;
+      anyDamped = anyDamped || clothSettings.material(kind).damping > 0.0;
     }
   }
   scratch_.resize(cloths_.size());
 
   const auto add = [this](Stage stage, bool perSubstep) { profile_.push_back({stage, perSubstep}); };
   if (model == Model::position) {
-    if (settings_.air.pressure > 0.0f && anyTriangles) add(Stage::windPressure, true);
+    if (settings_.air.pressure > 0.0 && anyTriangles) add(Stage::windPressure, true);
     add(Stage::verletIntegrate, true);
     if (anyProjected && settings_.solver.iterations > 0) add(Stage::projectConstraints, true);
     if (anyDamped) add(Stage::dampConstraints, true);
@@ -127,14 +133,14 @@ bool World::hasStage(Stage stage) const {
 Vec3 World::velocity(int cloth, ParticleIndex particle) const {
   const ParticleState& s = cloths_.at(static_cast<std::size_t>(cloth)).state;
   if (!s.velocity.empty()) return s.velocity.at(particle);
-  return (s.position.at(particle) - s.previousPosition.at(particle)) / static_cast<float>(substepDt());
+  return (s.position.at(particle) - s.previousPosition.at(particle)) / static_cast<Real>(substepDt());
 }
 
 void World::startHistory() {
-  const float h = static_cast<float>(substepDt());
+  const Real h = static_cast<Real>(substepDt());
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     if (settings_.solver.model == Model::position) {
-      if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(cloths_[c].state.position.size(), Vec3{0.0f});
+      if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(cloths_[c].state.position.size(), Vec3{0.0});
       position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity, h);
     } else {
       force::startHistory(cloths_[c], settings_, h, scratch_[c]);
@@ -144,7 +150,7 @@ void World::startHistory() {
 }
 
 void World::runStage(Stage stage) {
-  const float h = static_cast<float>(substepDt());
+  const Real h = static_cast<Real>(substepDt());
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     Cloth& cloth = cloths_[c];
     SolverScratch& scratch = scratch_[c];

@@ -27,7 +27,7 @@ std::string_view name(ConstraintKind kind);
 struct DistanceConstraint {
   ParticleIndex a;
   ParticleIndex b;
-  float restLength;  // m
+  Real restLength;  // m
 };
 
 // Which world plane the lattice is laid out in at rest.
@@ -40,9 +40,9 @@ std::string_view name(LatticePlane plane);
 struct LatticeSpec {
   int columns = 2;                 // particles along a row, >= 1
   int rows = 2;                    // particles along a column, >= 1 (1 makes a chain)
-  float width = 1.0f;              // m, distance from column 0 to the last column
-  float height = 1.0f;             // m, distance from row 0 to the last row
-  Vec3 origin{0.0f};               // m, rest position of particle (column 0, row 0)
+  Real width = 1.0;              // m, distance from column 0 to the last column
+  Real height = 1.0;             // m, distance from row 0 to the last row
+  Vec3 origin{0.0};               // m, rest position of particle (column 0, row 0)
   LatticePlane plane = LatticePlane::xz;
 };
 

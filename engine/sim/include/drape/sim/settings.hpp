@@ -37,14 +37,14 @@ struct SolverSettings {
   double dt = 1.0 / 60.0;                      // s, one step
   int substeps = 1;                            // each step is split into this many equal substeps
   int iterations = 20;                         // position model: constraint sweeps per substep
-  float damping = 0.0f;                        // 1/s, global velocity damping: a -= damping * v
+  Real damping = 0.0;                        // 1/s, global velocity damping: a -= damping * v
 };
 
 // The air around the cloth, moving uniformly at `velocity`.
 struct AirSettings {
-  Vec3 velocity{0.0f};   // m/s, the wind
-  float drag = 0.0f;     // 1/s, linear drag towards the air's velocity: a -= drag * (v - wind)
-  float pressure = 0.0f; // kg/(m^2 s), force on a triangle along its normal:
+  Vec3 velocity{0.0};   // m/s, the wind
+  Real drag = 0.0;     // 1/s, linear drag towards the air's velocity: a -= drag * (v - wind)
+  Real pressure = 0.0; // kg/(m^2 s), force on a triangle along its normal:
                          //   f = pressure * area * ((wind - v) . n) n   (what makes a flag flutter)
 };
 
@@ -54,8 +54,8 @@ struct AirSettings {
 //             removed per substep);
 //   force:    stiffness ks in N/m, damping kd in N s/m (the seed's spring-damper).
 struct KindMaterial {
-  float stiffness = 1.0f;
-  float damping = 0.0f;
+  Real stiffness = 1.0;
+  Real damping = 0.0;
 };
 
 struct Pin {
@@ -66,7 +66,8 @@ struct Pin {
 
 struct ClothSettings {
   LatticeSpec lattice;
-  float mass = 1.0f;  // kg, spread evenly over the particles
+  Real mass = 1.0;  // kg, spread evenly over the particles
+  Vec3 initialVelocity{0.0};  // m/s, of every unpinned particle at the start
   std::array<KindMaterial, kConstraintKindCount> materials{};
   std::vector<Pin> pins;
 
@@ -78,7 +79,7 @@ struct ClothSettings {
 
 struct WorldSettings {
   SolverSettings solver;
-  Vec3 gravity{0.0f, -9.81f, 0.0f};  // m/s^2
+  Vec3 gravity{0.0, -9.81, 0.0};  // m/s^2
   AirSettings air;
   std::vector<ClothSettings> cloths;
 };
@@ -89,6 +90,6 @@ inline constexpr long long kMaxParticles = 1 << 20;  // over all cloths of a wor
 inline constexpr int kMaxSubsteps = 1000;
 inline constexpr int kMaxIterations = 10000;
 // A particle farther than this from the origin is a runaway: the guard treats it like NaN.
-inline constexpr float kRunawayDistance = 1.0e6f;  // m
+inline constexpr Real kRunawayDistance = 1.0e6;  // m
 
 }  // namespace drape::sim

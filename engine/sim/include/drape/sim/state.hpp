@@ -12,7 +12,7 @@ struct ParticleState {
   std::vector<Vec3> position;          // m
   std::vector<Vec3> previousPosition;  // m, position one substep ago (Verlet's velocity-less memory)
   std::vector<Vec3> velocity;          // m/s, force model only; empty in the position model
-  std::vector<float> inverseMass;      // 1/kg; 0 for a pinned particle, which nothing moves
+  std::vector<Real> inverseMass;      // 1/kg; 0 for a pinned particle, which nothing moves
 };
 
 }  // namespace drape::sim

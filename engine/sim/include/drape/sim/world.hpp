@@ -21,7 +21,7 @@ struct Cloth {
   ClothRest rest;
   ParticleState state;
   ClothSettings settings;
-  float particleMass = 0.0f;  // kg, mass of every unpinned particle
+  Real particleMass = 0.0;  // kg, mass of every unpinned particle
 };
 
 struct Divergence {

@@ -1,0 +1,72 @@
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include "drape/sim/cloth.hpp"
+
+namespace drape::sim {
+namespace {
+
+TEST(Lattice, ConstraintCountsFollowTheSeedsLattice) {
+  const ClothRest rest = buildLattice({5, 4, 1.0, 0.75, Vec3{0.0}, LatticePlane::xz});
+  EXPECT_EQ(rest.particleCount(), 20u);
+  EXPECT_EQ(rest.of(ConstraintKind::stretch).size(), 4u * 4 + 5u * 3);  // horizontal + vertical neighbours
+  EXPECT_EQ(rest.of(ConstraintKind::shear).size(), 2u * 4 * 3);         // both diagonals of every cell
+  EXPECT_EQ(rest.of(ConstraintKind::bend).size(), 3u * 4 + 5u * 2);     // neighbours two apart
+  EXPECT_EQ(rest.triangles.size(), 2u * 4 * 3);
+}
+
+TEST(Lattice, RestLengthsAreTheSpacing) {
+  const ClothRest rest = buildLattice({5, 4, 1.0, 0.75, Vec3{0.0}, LatticePlane::xz});
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) {
+    const bool horizontal = rest.restPositions[c.a].z == rest.restPositions[c.b].z;
+    EXPECT_DOUBLE_EQ(c.restLength, 0.25) << horizontal;
+  }
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::shear)) EXPECT_DOUBLE_EQ(c.restLength, 0.25 * std::sqrt(2.0));
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::bend)) EXPECT_DOUBLE_EQ(c.restLength, 0.5);
+}
+
+TEST(Lattice, IndexIsRowMajorAndPlanesPointTheRightWay) {
+  const Vec3 origin{1.0, 2.0, 3.0};
+  const ClothRest flat = buildLattice({3, 2, 2.0, 1.0, origin, LatticePlane::xz});
+  EXPECT_EQ(flat.index(2, 1), 5u);
+  EXPECT_EQ(flat.restPositions[flat.index(2, 1)], (Vec3{3.0, 2.0, 4.0}));
+  const ClothRest hanging = buildLattice({3, 2, 2.0, 1.0, origin, LatticePlane::xy});
+  EXPECT_EQ(hanging.restPositions[hanging.index(2, 1)], (Vec3{3.0, 1.0, 3.0}));
+  // Front faces: +y for a flat sheet, +z for a hanging one.
+  for (const auto& [rest, up] : {std::pair{&flat, Vec3{0, 1, 0}}, std::pair{&hanging, Vec3{0, 0, 1}}}) {
+    for (const glm::uvec3& t : rest->triangles) {
+      const Vec3 n = glm::cross(rest->restPositions[t.y] - rest->restPositions[t.x],
+                                rest->restPositions[t.z] - rest->restPositions[t.x]);
+      EXPECT_GT(glm::dot(n, up), 0.0);
+    }
+  }
+}
+
+TEST(Lattice, ChainHasNoShearAndNoTriangles) {
+  const ClothRest chain = buildLattice({10, 1, 0.9, 1.0, Vec3{0.0}, LatticePlane::xy});
+  EXPECT_EQ(chain.of(ConstraintKind::stretch).size(), 9u);
+  EXPECT_EQ(chain.of(ConstraintKind::shear).size(), 0u);
+  EXPECT_EQ(chain.of(ConstraintKind::bend).size(), 8u);
+  EXPECT_TRUE(chain.triangles.empty());
+  const ClothRest one = buildLattice({1, 1, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz});
+  EXPECT_EQ(one.particleCount(), 1u);
+  for (const auto& list : one.constraints) EXPECT_TRUE(list.empty());
+}
+
+TEST(Lattice, UnusedKindsAreNotGenerated) {
+  const ClothRest rest = buildLattice({4, 4, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz}, {true, false, false});
+  EXPECT_FALSE(rest.of(ConstraintKind::stretch).empty());
+  EXPECT_TRUE(rest.of(ConstraintKind::shear).empty());
+  EXPECT_TRUE(rest.of(ConstraintKind::bend).empty());
+}
+
+TEST(Lattice, RejectsImpossibleSpecs) {
+  EXPECT_THROW(buildLattice({0, 4, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
+  EXPECT_THROW(buildLattice({4, 4, 0.0, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
+  EXPECT_THROW(buildLattice({5000, 4, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
+  EXPECT_THROW(buildLattice({4000, 4000, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace drape::sim

@@ -1,0 +1,104 @@
+// World-level behaviour: the pipeline a scene gets, determinism, and the divergence guard.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "drape/sim/metrics.hpp"
+#include "drape/sim/world.hpp"
+#include "world_builder.hpp"
+
+namespace drape::sim {
+namespace {
+
+std::vector<Stage> stages(const World& world) {
+  std::vector<Stage> result;
+  for (const StageTiming& timing : world.profile()) result.push_back(timing.stage);
+  return result;
+}
+
+TEST(Pipeline, HoldsOnlyTheStagesTheSceneUses) {
+  WorldSettings settings = test::hangingSheet(8, 10, 1);
+  EXPECT_EQ(stages(World(settings)), (std::vector{Stage::verletIntegrate, Stage::projectConstraints, Stage::guard}));
+
+  settings.air.pressure = 1.0;
+  settings.air.velocity = Vec3{1.0, 0.0, 0.0};
+  settings.cloths[0].material(ConstraintKind::bend).damping = 0.1;
+  EXPECT_EQ(stages(World(settings)), (std::vector{Stage::windPressure, Stage::verletIntegrate,
+                                                  Stage::projectConstraints, Stage::dampConstraints, Stage::guard}));
+
+  WorldSettings springs = test::verticalSpring(Model::force, Integrator::rk4, 0.01, 100.0, 1.0);
+  EXPECT_EQ(stages(World(springs)), (std::vector{Stage::rk4, Stage::guard}));
+  springs.solver.integrator = Integrator::symplecticEuler;
+  EXPECT_EQ(stages(World(springs)), (std::vector{Stage::symplecticEuler, Stage::guard}));
+}
+
+TEST(Pipeline, EveryStageIsTimed) {
+  World world(test::hangingSheet(16, 10, 2));
+  world.run(5);
+  for (const StageTiming& timing : world.profile()) {
+    EXPECT_GE(timing.lastSeconds, 0.0);
+    EXPECT_GE(timing.totalSeconds, timing.lastSeconds);
+  }
+  EXPECT_GT(world.profile()[1].totalSeconds, 0.0);  // projecting 1000+ constraints takes some time
+}
+
+template <typename Settings>
+void expectBitIdentical(const Settings& settings, int steps) {
+  World a(settings), b(settings);
+  a.run(steps);
+  b.run(steps);
+  const auto& xa = a.cloths()[0].state.position;
+  const auto& xb = b.cloths()[0].state.position;
+  ASSERT_EQ(xa.size(), xb.size());
+  EXPECT_EQ(std::memcmp(xa.data(), xb.data(), xa.size() * sizeof(Vec3)), 0);
+}
+
+TEST(Determinism, SameSceneTwiceGivesBitIdenticalPositions) {
+  WorldSettings sheet = test::hangingSheet(20, 10, 2);
+  sheet.air = {Vec3{0.0, 0.0, 3.0}, 0.1, 0.5};
+  expectBitIdentical(sheet, 100);
+  WorldSettings springs = test::verticalSpring(Model::force, Integrator::midpoint, 0.001, 1000.0, 0.1);
+  expectBitIdentical(springs, 500);
+}
+
+TEST(Guard, StopsAtTheFirstNonFiniteStepAndRestoresTheLastGoodState) {
+  // A stiff spring under explicit Euler with a large step: |1 + i omega h| = 10 per step.
+  World world(test::verticalSpring(Model::force, Integrator::explicitEuler, 0.01, 1.0e6, 1.0));
+  const StepStatus status = world.run(10000);
+  ASSERT_EQ(status, StepStatus::diverged);
+  ASSERT_TRUE(world.divergence().has_value());
+  const std::int64_t badStep = world.divergence()->step;
+  EXPECT_GT(badStep, 1);
+  EXPECT_EQ(world.stepCount(), badStep - 1);  // the bad step did not count
+  for (const Vec3& x : world.cloths()[0].state.position) {
+    EXPECT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
+    EXPECT_LE(std::abs(x.y), kRunawayDistance);
+  }
+  EXPECT_EQ(world.step(), StepStatus::diverged);  // and it does not step on
+  EXPECT_EQ(world.stepCount(), badStep - 1);
+}
+
+TEST(Guard, AStableRunNeverTrips) {
+  World world(test::hangingSheet(16, 10, 2));
+  EXPECT_EQ(world.run(300), StepStatus::ok);
+  EXPECT_FALSE(world.divergence().has_value());
+}
+
+TEST(World, RejectsSettingsOutsideItsLimits) {
+  WorldSettings settings = test::hangingSheet(4, 10, 1);
+  settings.solver.dt = 0.0;
+  EXPECT_THROW(World{settings}, std::invalid_argument);
+  settings = test::hangingSheet(4, 10, 1);
+  settings.cloths[0].mass = -1.0;
+  EXPECT_THROW(World{settings}, std::invalid_argument);
+  settings = test::hangingSheet(4, 10, 1);
+  settings.cloths[0].pins.push_back({4, 0, std::nullopt});
+  EXPECT_THROW(World{settings}, std::invalid_argument);
+  settings = test::hangingSheet(4, 10, 1);
+  settings.gravity.y = NAN;
+  EXPECT_THROW(World{settings}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace drape::sim
