@@ -1,1 +1,231 @@
+// Whole-program tests: the real drape-cli binary on real files, its outputs and its exit codes.
 #include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Result {
+  int exitCode;
+  std::string out;
+  std::string err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    directory_ = fs::temp_directory_path() / ("drape-cli-test-" + std::string(test->name()) + "-" +
+                                              std::to_string(::getpid()));
+    fs::remove_all(directory_);
+    fs::create_directories(directory_);
+  }
+  void TearDown() override { fs::remove_all(directory_); }
+
+  fs::path file(const std::string& name) const { return directory_ / name; }
+
+  fs::path write(const std::string& name, const std::string& contents) const {
+    std::ofstream(file(name)) << contents;
+    return file(name);
+  }
+
+  static std::string read(const fs::path& path) {
+    std::ifstream in(path);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+
+  // Runs drape-cli with `arguments` (shell words), capturing stdout and stderr.
+  Result run(const std::string& arguments) const {
+    const fs::path out = file("stdout.txt"), err = file("stderr.txt");
+    const std::string command = std::string("'") + DRAPE_CLI + "' " + arguments + " >'" + out.string() + "' 2>'" +
+                                err.string() + "'";
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read(out), read(err)};
+  }
+
+  // A minimal valid scene with one 4 x 3 cloth.
+  static json scene() {
+    return json::parse(R"({"solver": {"dt": 0.01}, "cloths": [{"grid": {"columns": 4, "rows": 3, "width": 0.3,
+      "height": 0.2}, "origin": [0, 1, 0], "pins": [{"particle": [0, 0]}]}]})");
+  }
+
+  fs::path directory_;
+};
+
+void expectOneLineError(const Result& result, int exitCode, const std::string& fragment) {
+  EXPECT_EQ(result.exitCode, exitCode) << result.err;
+  EXPECT_NE(result.err.find(fragment), std::string::npos) << "stderr: " << result.err;
+  EXPECT_EQ(result.err.rfind("drape-cli: error: ", 0), 0u) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
+TEST_F(Cli, ValidatesTheShippedScenes) {
+  for (const char* name : {"hang", "trampoline", "chain", "curtain", "hang-springs", "spring"}) {
+    const Result result = run(std::string("validate ") + name);
+    EXPECT_EQ(result.exitCode, 0) << name << ": " << result.err;
+    EXPECT_NE(result.out.find(": ok: "), std::string::npos) << result.out;
+  }
+}
+
+TEST_F(Cli, StateFileHoldsEveryParticleRowByRow) {
+  const fs::path sceneFile = write("s.json", scene().dump());
+  const fs::path state = file("state.json");
+  const Result result = run("run '" + sceneFile.string() + "' --steps 0 --out '" + state.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const json document = json::parse(read(state));
+  EXPECT_EQ(document["steps"], 0);
+  const json& cloth = document["cloths"][0];
+  ASSERT_EQ(cloth["positions"].size(), 12u);
+  // index = row * columns + column; at rest, x = 0.1 column and z = 0.1 row on the xz plane.
+  for (int row = 0; row < 3; ++row) {
+    for (int column = 0; column < 4; ++column) {
+      const json& p = cloth["positions"][static_cast<std::size_t>(row * 4 + column)];
+      EXPECT_NEAR(p[0].get<double>(), 0.1 * column, 1e-12);
+      EXPECT_NEAR(p[1].get<double>(), 1.0, 1e-12);
+      EXPECT_NEAR(p[2].get<double>(), 0.1 * row, 1e-12);
+    }
+  }
+  EXPECT_TRUE(document["metrics"]["strain"].contains("max"));
+  EXPECT_TRUE(document["metrics"]["energy"].contains("total"));
+}
+
+TEST_F(Cli, RunMatchesFreeFallAndTracesEveryStep) {
+  // One free particle, no constraints: the trace is the parabola y = 1 - g t^2 / 2.
+  json particle = scene();
+  particle["cloths"][0] = json::parse(R"({"grid": {"columns": 1, "rows": 1}, "origin": [0, 1, 0]})");
+  const fs::path sceneFile = write("fall.json", particle.dump());
+  const fs::path trace = file("trace.csv");
+  const Result result =
+      run("run '" + sceneFile.string() + "' --steps 50 --trace 0,0 --trace-out '" + trace.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::istringstream lines(read(trace));
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "time,x,y,z");
+  int rows = 0;
+  while (std::getline(lines, line)) {
+    double t, x, y, z;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &t, &x, &y, &z), 4) << line;
+    EXPECT_NEAR(t, 0.01 * rows, 1e-9);
+    EXPECT_NEAR(y, 1.0 - 0.5 * 9.81 * t * t, 1e-6) << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 51);  // t = 0 and every step
+}
+
+TEST_F(Cli, ObjMeshHasVerticesNormalsAndFaces) {
+  const fs::path sceneFile = write("s.json", scene().dump());
+  const fs::path mesh = file("cloth.obj");
+  ASSERT_EQ(run("run '" + sceneFile.string() + "' --steps 10 --out '" + mesh.string() + "'").exitCode, 0);
+  std::istringstream lines(read(mesh));
+  std::string line;
+  int vertices = 0, normals = 0, faces = 0;
+  while (std::getline(lines, line)) {
+    vertices += line.rfind("v ", 0) == 0;
+    normals += line.rfind("vn ", 0) == 0;
+    if (line.rfind("f ", 0) == 0) {
+      ++faces;
+      int a, b, c, na, nb, nc;
+      ASSERT_EQ(std::sscanf(line.c_str(), "f %d//%d %d//%d %d//%d", &a, &na, &b, &nb, &c, &nc), 6) << line;
+      for (int index : {a, b, c}) EXPECT_TRUE(index >= 1 && index <= 12) << line;
+    }
+  }
+  EXPECT_EQ(vertices, 12);
+  EXPECT_EQ(normals, 12);
+  EXPECT_EQ(faces, 2 * 3 * 2);
+}
+
+TEST_F(Cli, OverridesChangeTheRun) {
+  const fs::path state = file("state.json");
+  ASSERT_EQ(run("run chain --steps 1 --set cloths.0.grid.columns=7 --out '" + state.string() + "'").exitCode, 0);
+  EXPECT_EQ(json::parse(read(state))["cloths"][0]["positions"].size(), 7u);
+}
+
+TEST_F(Cli, DivergenceExitsOneWithTheStepAndWritesNothing) {
+  json stiff = scene();
+  stiff["solver"] = json::parse(R"({"model": "force", "integrator": "explicit-euler", "dt": 0.01})");
+  stiff["cloths"][0]["stretch"] = json::parse(R"({"stiffness": 1e7})");
+  const fs::path sceneFile = write("stiff.json", stiff.dump());
+  const fs::path state = file("state.json");
+  const Result result = run("run '" + sceneFile.string() + "' --steps 1000 --out '" + state.string() + "'");
+  expectOneLineError(result, 1, "diverged at step ");
+  EXPECT_FALSE(fs::exists(state));
+}
+
+struct BadInput {
+  const char* name;
+  const char* sceneText;  // written to bad.json; nullptr: use the valid scene
+  const char* arguments;  // after "run bad.json" / "validate bad.json"
+  const char* fragment;   // expected in the one-line message
+};
+
+void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
+
+class CliBadInput : public Cli, public ::testing::WithParamInterface<BadInput> {};
+
+TEST_P(CliBadInput, ExitsTwoWithOneLineNamingTheProblem) {
+  const BadInput& c = GetParam();
+  const fs::path sceneFile = write("bad.json", c.sceneText ? c.sceneText : scene().dump());
+  const fs::path state = file("state.json");
+  const Result result =
+      run("run '" + sceneFile.string() + "' --steps 3 --out '" + state.string() + "' " + c.arguments);
+  expectOneLineError(result, 2, c.fragment);
+  EXPECT_FALSE(fs::exists(state)) << "a failed run must not write its output";
+  if (c.sceneText) expectOneLineError(run("validate '" + sceneFile.string() + "'"), 2, c.fragment);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CliBadInput,
+    ::testing::Values(
+        BadInput{"MalformedJson", R"({"cloths": [)", "", "bad.json: malformed JSON: parse error at line 1"},
+        BadInput{"UnknownKey", R"({"cloths": [], "colour": 3})", "", "bad.json: colour: unknown key"},
+        BadInput{"WrongType", R"({"solver": {"dt": "small"}})", "", "bad.json: solver.dt: expected a number > 0"},
+        BadInput{"NegativeMass", R"({"cloths": [{"grid": {}, "mass": -2}]})", "", "bad.json: cloths.0.mass: expected"},
+        BadInput{"ZeroSize", R"({"cloths": [{"grid": {"height": 0}}]})", "", "bad.json: cloths.0.grid.height: expected"},
+        BadInput{"ZeroDt", R"({"solver": {"dt": 0}})", "", "bad.json: solver.dt: expected a number > 0"},
+        BadInput{"TooManyParticles", R"({"cloths": [{"grid": {"columns": 4096, "rows": 4096}}]})", "",
+                 "particles pass the limit of 1048576"},
+        BadInput{"PinOutsideGrid", R"({"cloths": [{"grid": {"columns": 3, "rows": 3}, "pins": [{"particle": [3, 0]}]}]})", "",
+                 "bad.json: cloths.0.pins.0.particle: expected [column, row] inside the 3 x 3 grid, got [3,0]"},
+        BadInput{"InfiniteNumber", R"({"gravity": [0, -1e999, 0]})", "", "bad.json: malformed JSON: number overflow"},
+        BadInput{"NotAnObject", R"([1, 2, 3])", "", "bad.json: (document): expected an object"},
+        BadInput{"NaNFromSet", nullptr, "--set solver.dt=nan", "solver.dt: expected a number > 0 and <= 1 (s), got \"nan\""},
+        BadInput{"BadSetPath", nullptr, "--set cloths.4.mass=1", "--set cloths.4.mass=1: 4 is not an index"},
+        BadInput{"UnknownKeyFromSet", nullptr, "--set solver.iteratons=5", "solver.iteratons: unknown key"},
+        BadInput{"NegativeSteps", nullptr, "--steps -1", "--steps"},
+        BadInput{"NonNumericSteps", nullptr, "--steps many", "--steps"},
+        BadInput{"UnknownOption", nullptr, "--colour red", "--colour"},
+        BadInput{"BadOutputKind", nullptr, "--out x.txt", "--out x.txt: expected a file ending in .json"},
+        BadInput{"UnwritableOutput", nullptr, "--out /nonexistent-dir/s.json", "/nonexistent-dir/s.json: cannot write"},
+        BadInput{"TraceOutsideGrid", nullptr, "--trace 9,0 --trace-out t.csv", "--trace 9,0: outside the 4 x 3 grid"},
+        BadInput{"TraceNotNumbers", nullptr, "--trace a,b --trace-out t.csv", "--trace a,b: expected column,row"},
+        BadInput{"TraceWithoutOut", nullptr, "--trace 0,0", "--trace"}),
+    [](const auto& testInfo) { return std::string(testInfo.param.name); });
+
+TEST_F(Cli, MissingSceneFileIsBadInput) {
+  expectOneLineError(run("run '" + file("nope.json").string() + "'"), 2, "nope.json: cannot open the scene file");
+  expectOneLineError(run("validate nothing-by-this-name"), 2, "nothing-by-this-name: cannot open the scene file");
+}
+
+TEST_F(Cli, NoSubcommandIsBadInputAndHelpIsNot) {
+  EXPECT_EQ(run("").exitCode, 2);
+  const Result help = run("--help");
+  EXPECT_EQ(help.exitCode, 0);
+  EXPECT_NE(help.out.find("validate"), std::string::npos);
+}
+
+}  // namespace

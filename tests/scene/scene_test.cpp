@@ -1,1 +1,150 @@
+// Scene files: the shipped scenes, overrides, and what the reader refuses.
 #include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/scene/error.hpp"
+#include "drape/scene/scene.hpp"
+#include "drape/sim/world.hpp"
+
+namespace drape::scene {
+namespace {
+
+using nlohmann::json;
+
+TEST(ShippedScenes, AllLoadAndBuildAWorld) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(sceneDirectory())) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Scene scene = loadScene(entry.path());
+    EXPECT_FALSE(scene.description.empty());
+    sim::World world(scene.world);
+    EXPECT_EQ(world.run(10), sim::StepStatus::ok);
+    ++count;
+  }
+  EXPECT_GE(count, 3);
+}
+
+TEST(ShippedScenes, ResolveByName) {
+  EXPECT_EQ(resolveScenePath("hang"), sceneDirectory() / "hang.json");
+  EXPECT_EQ(loadScene(resolveScenePath("chain")).world.cloths.at(0).lattice.rows, 1);
+}
+
+json minimal() {
+  return json::parse(R"({"cloths": [{"grid": {"columns": 4, "rows": 3}, "pins": [{"particle": [0, 0]}]}]})");
+}
+
+TEST(SceneReader, AbsentKeysTakeTheDocumentedDefaults) {
+  const Scene scene = parseScene(minimal(), "mem.json");
+  EXPECT_EQ(scene.name, "mem");
+  EXPECT_EQ(scene.world.solver.model, sim::Model::position);
+  EXPECT_DOUBLE_EQ(scene.world.solver.dt, 1.0 / 60.0);
+  EXPECT_DOUBLE_EQ(scene.world.gravity.y, -9.81);
+  const sim::ClothSettings& cloth = scene.world.cloths.at(0);
+  EXPECT_EQ(cloth.lattice.plane, sim::LatticePlane::xz);
+  EXPECT_DOUBLE_EQ(cloth.mass, 1.0);
+  EXPECT_DOUBLE_EQ(cloth.material(sim::ConstraintKind::stretch).stiffness, 1.0);
+  ASSERT_EQ(cloth.pins.size(), 1u);
+  EXPECT_FALSE(cloth.pins[0].position.has_value());
+}
+
+TEST(SceneReader, ForceModelMaterialsAreSprings) {
+  json document = minimal();
+  applyOverride(document, "solver.model=force");
+  applyOverride(document, "solver.integrator=rk4");
+  applyOverride(document, "cloths.0.stretch.stiffness=5000");
+  const Scene scene = parseScene(document, "mem.json");
+  EXPECT_EQ(scene.world.solver.integrator, sim::Integrator::rk4);
+  EXPECT_DOUBLE_EQ(scene.world.cloths[0].material(sim::ConstraintKind::stretch).stiffness, 5000.0);
+}
+
+TEST(Overrides, SetNumbersStringsArraysAndCreateMissingObjects) {
+  json document = minimal();
+  applyOverride(document, "cloths.0.grid.columns=64");
+  applyOverride(document, "solver.model=force");
+  applyOverride(document, "gravity=[0,-1.62,0]");
+  applyOverride(document, "cloths.0.pins.0.particle=[3,2]");
+  EXPECT_EQ(document["cloths"][0]["grid"]["columns"], 64);
+  EXPECT_EQ(document["solver"]["model"], "force");
+  EXPECT_EQ(document["gravity"][1], -1.62);
+  EXPECT_EQ(document["cloths"][0]["pins"][0]["particle"], json::parse("[3,2]"));
+}
+
+std::string errorOf(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+TEST(Overrides, BadAssignmentsAreErrorsNamingTheOption) {
+  json document = minimal();
+  EXPECT_EQ(errorOf([&] { applyOverride(document, "solver.dt"); }),
+            "--set solver.dt: expected path=value, e.g. cloths.0.grid.columns=64");
+  EXPECT_EQ(errorOf([&] { applyOverride(document, "cloths.3.mass=1"); }),
+            "--set cloths.3.mass=1: 3 is not an index of an array of 1");
+  EXPECT_EQ(errorOf([&] { applyOverride(document, "cloths.0.grid.columns.x=1"); }),
+            "--set cloths.0.grid.columns.x=1: cannot go into 4 at x");
+}
+
+struct BadScene {
+  const char* override;
+  const char* message;
+};
+
+void PrintTo(const BadScene& c, std::ostream* os) { *os << c.override; }
+
+class SceneErrors : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(SceneErrors, NameTheFileTheKeyAndWhatWasExpected) {
+  json document = minimal();
+  applyOverride(document, GetParam().override);
+  EXPECT_EQ(errorOf([&] { parseScene(document, "s.json"); }), GetParam().message);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, SceneErrors,
+    ::testing::Values(
+        BadScene{"clothes=[]", "s.json: clothes: unknown key"},
+        BadScene{"cloths.0.grid.colums=3", "s.json: cloths.0.grid.colums: unknown key"},
+        BadScene{"solver.dt=fast", "s.json: solver.dt: expected a number > 0 and <= 1 (s), got \"fast\""},
+        BadScene{"solver.dt=0", "s.json: solver.dt: expected a number > 0 and <= 1 (s), got 0"},
+        BadScene{"cloths.0.mass=-1", "s.json: cloths.0.mass: expected a number > 0 and <= 1000000 (kg), got -1"},
+        BadScene{"cloths.0.grid.width=0", "s.json: cloths.0.grid.width: expected a number > 0 and <= 1000 (m), got 0"},
+        BadScene{"cloths.0.grid.columns=2.5", "s.json: cloths.0.grid.columns: expected an integer from 1 to 4096, got 2.5"},
+        BadScene{"cloths.0.grid.rows=5000", "s.json: cloths.0.grid.rows: expected an integer from 1 to 4096, got 5000"},
+        BadScene{"cloths.0.pins.0.particle=[4,0]",
+                 "s.json: cloths.0.pins.0.particle: expected [column, row] inside the 4 x 3 grid, got [4,0]"},
+        BadScene{"cloths.0.pins.0.particle=\"corner\"",
+                 "s.json: cloths.0.pins.0.particle: expected [column, row] inside the 4 x 3 grid, got \"corner\""},
+        BadScene{"gravity=[0,-9.81]",
+                 "s.json: gravity: expected [x, y, z]: three numbers within +-1000 (m/s^2), got [0,-9.81]"},
+        BadScene{"solver.model=implicit",
+                 "s.json: solver.model: expected one of \"position\" \"force\", got \"implicit\""},
+        BadScene{"solver.integrator=rk4",
+                 "s.json: solver.integrator: expected \"verlet\" for the position model (the others belong to "
+                 "\"model\": \"force\"), got \"rk4\""},
+        BadScene{"cloths.0.stretch.stiffness=2",
+                 "s.json: cloths.0.stretch.stiffness: expected a number >= 0 and <= 1 (fraction corrected per "
+                 "sweep), got 2"},
+        BadScene{"solver=[]", "s.json: solver: expected an object { ... }, got []"},
+        BadScene{"cloths.0.grid={\"columns\":2048,\"rows\":1024}",
+                 "s.json: cloths.0.grid: 2048 x 1024 particles pass the limit of 1048576 particles over all cloths"}));
+
+TEST(SceneErrors, NonFiniteNumbersAreRefused) {
+  // JSON has no NaN or infinity literals; a number too large for a double is the way one sneaks in.
+  json document = minimal();
+  document["solver"]["dt"] = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(errorOf([&] { parseScene(document, "s.json"); }),
+            "s.json: solver.dt: expected a number > 0 and <= 1 (s), got a non-finite number");
+  document = minimal();
+  document["gravity"] = {0.0, std::nan(""), 0.0};
+  EXPECT_NE(errorOf([&] { parseScene(document, "s.json"); }).find("s.json: gravity: expected [x, y, z]"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace drape::scene

@@ -94,6 +94,8 @@ struct IntegratorCase {
   int periods;
 };
 
+void PrintTo(const IntegratorCase& c, std::ostream* os) { *os << name(c.integrator); }
+
 class Oscillator : public ::testing::TestWithParam<IntegratorCase> {};
 
 TEST_P(Oscillator, PeriodIsWhatTheIntegratorsAmplificationFactorPredicts) {

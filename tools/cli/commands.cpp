@@ -142,19 +142,13 @@ int run(const RunArguments& arguments) {
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-    std::vector<std::string> written;
+    std::vector<scene::OutputFile> files;
     for (const std::string& file : arguments.outputs) {
-      if (outputKind(file) == OutputKind::state) {
-        scene::writeFileAtomically(file, scene::stateDocument(scene, world).dump(1) + "\n");
-      } else {
-        scene::writeFileAtomically(file, scene::objText(world));
-      }
-      written.push_back(file);
+      files.push_back({file, outputKind(file) == OutputKind::state ? scene::stateDocument(scene, world).dump(1) + "\n"
+                                                                    : scene::objText(world)});
     }
-    if (arguments.traceOut) {
-      scene::writeFileAtomically(*arguments.traceOut, trace.str());
-      written.push_back(*arguments.traceOut);
-    }
+    if (arguments.traceOut) files.push_back({*arguments.traceOut, trace.str()});
+    scene::writeFilesAtomically(files);
 
     if (!arguments.quiet) {
       const sim::StrainStats strain = sim::structuralStrain(world);
@@ -162,7 +156,7 @@ int run(const RunArguments& arguments) {
       std::printf("%s: %lld steps (%.3f s simulated) in %.3f s; %zu particles; structural strain max %.2f %%, mean %.3f %%; energy %.4g J\n",
                   scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds,
                   countParticles(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
-      for (const std::string& file : written) std::printf("wrote %s\n", file.c_str());
+      for (const scene::OutputFile& file : files) std::printf("wrote %s\n", file.path.c_str());
     }
     return kExitOk;
   } catch (const scene::InputError& error) {

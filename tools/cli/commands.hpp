@@ -1,5 +1,6 @@
 // drape-cli's subcommands. Each returns the process exit code:
-//   0 success, 1 the simulation diverged, 2 bad input (scene, option, unwritable output).
+//   0 success, 1 the simulation diverged, 2 bad input (scene, option, unwritable output),
+//   3 an internal error (a bug: please report it).
 #pragma once
 
 #include <cstdint>
@@ -12,6 +13,7 @@ namespace drape::cli {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitDiverged = 1;
 inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitInternal = 3;
 
 struct SceneArguments {
   std::string scene;                  // path, or the name of a shipped scene

@@ -45,7 +45,12 @@ int main(int argc, char** argv) {
     std::cerr << "drape-cli: error: " << error.what() << " (see drape-cli --help)\n";
     return kExitBadInput;
   }
-  if (*validateCommand) return validate(validateArguments);
-  if (*runCommand) return run(runArguments);
-  return listScenes();
+  try {
+    if (*validateCommand) return validate(validateArguments);
+    if (*runCommand) return run(runArguments);
+    return listScenes();
+  } catch (const std::exception& error) {  // a bug, not bad input: say so rather than abort
+    std::cerr << "drape-cli: internal error: " << error.what() << "\n";
+    return kExitInternal;
+  }
 }

@@ -6,6 +6,7 @@
 namespace drape::scene {
 
 std::string describe(const nlohmann::json& value) {
+  if (value.is_number_float() && !std::isfinite(value.get<double>())) return "a non-finite number";
   std::string text = value.dump();
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return text;
@@ -13,6 +14,7 @@ std::string describe(const nlohmann::json& value) {
 
 std::string formatRange(const Range& range) {
   std::ostringstream out;
+  out.precision(12);
   out << "a number " << (range.minExclusive ? "> " : ">= ") << range.min << " and <= " << range.max;
   if (!range.unit.empty()) out << " (" << range.unit << ")";
   return out.str();
@@ -86,6 +88,7 @@ std::string ObjectReader::choice(std::string_view key, std::string fallback,
 sim::Vec3 readVec3(const nlohmann::json& value, const std::string& path, const std::string& source, double maxAbs,
                    std::string_view unit) {
   std::ostringstream expected;
+  expected.precision(12);
   expected << "[x, y, z]: three numbers within +-" << maxAbs;
   if (!unit.empty()) expected << " (" << unit << ")";
   if (!value.is_array() || value.size() != 3) failAt(source, path, expected.str(), &value);

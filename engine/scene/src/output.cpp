@@ -12,30 +12,59 @@
 
 namespace drape::scene {
 
-void writeFileAtomically(const std::filesystem::path& file, std::string_view contents) {
-  namespace fs = std::filesystem;
-  const std::string name = file.string();
-  if (file.filename().empty()) throw InputError(name + ": cannot write: not a file name");
-  std::error_code error;
-  if (fs::is_directory(file, error)) throw InputError(name + ": cannot write: it is a directory");
-  fs::path temporary = file;
+namespace {
+
+std::filesystem::path temporaryName(const std::filesystem::path& file) {
+  std::filesystem::path temporary = file;
   temporary += ".part";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(name + ": cannot write: the directory is missing or not writable");
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(temporary, error);
-      throw InputError(name + ": cannot write: the write failed (disk full?)");
+  return temporary;
+}
+
+void removeTemporaries(const std::vector<OutputFile>& files, std::size_t count) {
+  std::error_code ignored;
+  for (std::size_t i = 0; i < count; ++i) std::filesystem::remove(temporaryName(files[i].path), ignored);
+}
+
+}  // namespace
+
+void writeFilesAtomically(const std::vector<OutputFile>& files) {
+  namespace fs = std::filesystem;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const fs::path& file = files[i].path;
+    const std::string name = file.string();
+    std::error_code error;
+    std::string problem;
+    if (file.filename().empty()) {
+      problem = "not a file name";
+    } else if (fs::is_directory(file, error)) {
+      problem = "it is a directory";
+    } else {
+      std::ofstream out(temporaryName(file), std::ios::binary | std::ios::trunc);
+      if (!out) {
+        problem = "the directory is missing or not writable";
+      } else {
+        out.write(files[i].contents.data(), static_cast<std::streamsize>(files[i].contents.size()));
+        out.flush();
+        if (!out) problem = "the write failed (disk full?)";
+      }
+    }
+    if (!problem.empty()) {
+      removeTemporaries(files, i + 1);
+      throw InputError(name + ": cannot write: " + problem);
     }
   }
-  fs::rename(temporary, file, error);
-  if (error) {
-    fs::remove(temporary, error);
-    throw InputError(name + ": cannot write: " + error.message());
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    std::error_code error;
+    fs::rename(temporaryName(files[i].path), files[i].path, error);
+    if (error) {
+      removeTemporaries(files, files.size());
+      throw InputError(files[i].path.string() + ": cannot write: " + error.message());
+    }
   }
+}
+
+void writeFileAtomically(const std::filesystem::path& file, std::string_view contents) {
+  writeFilesAtomically({{file, std::string(contents)}});
 }
 
 nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {

@@ -209,11 +209,13 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
   json document;
   try {
     document = json::parse(text.str());
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
     // nlohmann's message: "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
+    // nlohmann's messages start with a tag: "[json.exception.parse_error.101] parse error at line 3, ..."
     std::string message = e.what();
-    const std::size_t at = message.find("parse error");
-    throw InputError(source + ": malformed JSON: " + (at == std::string::npos ? message : message.substr(at)));
+    const std::size_t tagEnd = message.find("] ");
+    if (tagEnd != std::string::npos) message = message.substr(tagEnd + 2);
+    throw InputError(source + ": malformed JSON: " + message);
   }
   for (const std::string& assignment : overrides) applyOverride(document, assignment);
   return parseScene(document, source);

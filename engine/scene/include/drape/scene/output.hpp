@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -14,7 +15,14 @@
 
 namespace drape::scene {
 
-// Throws InputError naming the file when it cannot be written.
+struct OutputFile {
+  std::filesystem::path path;
+  std::string contents;
+};
+
+// Writes every file or none: all go to temporary names first, and are renamed into place only
+// when all were written. Throws InputError naming the file that could not be written.
+void writeFilesAtomically(const std::vector<OutputFile>& files);
 void writeFileAtomically(const std::filesystem::path& file, std::string_view contents);
 
 // Positions of every particle (row by row: index = row * columns + column) and the run's metrics.
