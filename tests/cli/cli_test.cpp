@@ -27,8 +27,8 @@ class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    directory_ = fs::temp_directory_path() / ("drape-cli-test-" + std::string(test->name()) + "-" +
-                                              std::to_string(::getpid()));
+    directory_ =
+        fs::temp_directory_path() / ("drape-cli-test-" + std::string(test->name()) + "-" + std::to_string(::getpid()));
     fs::remove_all(directory_);
     fs::create_directories(directory_);
   }
@@ -51,8 +51,8 @@ class Cli : public ::testing::Test {
   // Runs drape-cli with `arguments` (shell words), capturing stdout and stderr.
   Result run(const std::string& arguments) const {
     const fs::path out = file("stdout.txt"), err = file("stderr.txt");
-    const std::string command = std::string("'") + DRAPE_CLI + "' " + arguments + " >'" + out.string() + "' 2>'" +
-                                err.string() + "'";
+    const std::string command =
+        std::string("'") + DRAPE_CLI + "' " + arguments + " >'" + out.string() + "' 2>'" + err.string() + "'";
     const int status = std::system(command.c_str());
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read(out), read(err)};
   }
@@ -181,8 +181,7 @@ TEST_P(CliBadInput, ExitsTwoWithOneLineNamingTheProblem) {
   const BadInput& c = GetParam();
   const fs::path sceneFile = write("bad.json", c.sceneText ? c.sceneText : scene().dump());
   const fs::path state = file("state.json");
-  const Result result =
-      run("run '" + sceneFile.string() + "' --steps 3 --out '" + state.string() + "' " + c.arguments);
+  const Result result = run("run '" + sceneFile.string() + "' --steps 3 --out '" + state.string() + "' " + c.arguments);
   expectOneLineError(result, 2, c.fragment);
   EXPECT_FALSE(fs::exists(state)) << "a failed run must not write its output";
   if (c.sceneText) expectOneLineError(run("validate '" + sceneFile.string() + "'"), 2, c.fragment);
@@ -195,15 +194,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"UnknownKey", R"({"cloths": [], "colour": 3})", "", "bad.json: colour: unknown key"},
         BadInput{"WrongType", R"({"solver": {"dt": "small"}})", "", "bad.json: solver.dt: expected a number > 0"},
         BadInput{"NegativeMass", R"({"cloths": [{"grid": {}, "mass": -2}]})", "", "bad.json: cloths.0.mass: expected"},
-        BadInput{"ZeroSize", R"({"cloths": [{"grid": {"height": 0}}]})", "", "bad.json: cloths.0.grid.height: expected"},
+        BadInput{"ZeroSize", R"({"cloths": [{"grid": {"height": 0}}]})", "",
+                 "bad.json: cloths.0.grid.height: expected"},
         BadInput{"ZeroDt", R"({"solver": {"dt": 0}})", "", "bad.json: solver.dt: expected a number > 0"},
         BadInput{"TooManyParticles", R"({"cloths": [{"grid": {"columns": 4096, "rows": 4096}}]})", "",
                  "particles pass the limit of 1048576"},
-        BadInput{"PinOutsideGrid", R"({"cloths": [{"grid": {"columns": 3, "rows": 3}, "pins": [{"particle": [3, 0]}]}]})", "",
+        BadInput{"PinOutsideGrid",
+                 R"({"cloths": [{"grid": {"columns": 3, "rows": 3}, "pins": [{"particle": [3, 0]}]}]})", "",
                  "bad.json: cloths.0.pins.0.particle: expected [column, row] inside the 3 x 3 grid, got [3,0]"},
         BadInput{"InfiniteNumber", R"({"gravity": [0, -1e999, 0]})", "", "bad.json: malformed JSON: number overflow"},
         BadInput{"NotAnObject", R"([1, 2, 3])", "", "bad.json: (document): expected an object"},
-        BadInput{"NaNFromSet", nullptr, "--set solver.dt=nan", "solver.dt: expected a number > 0 and <= 1 (s), got \"nan\""},
+        BadInput{"NaNFromSet", nullptr, "--set solver.dt=nan",
+                 "solver.dt: expected a number > 0 and <= 1 (s), got \"nan\""},
         BadInput{"BadSetPath", nullptr, "--set cloths.4.mass=1", "--set cloths.4.mass=1: 4 is not an index"},
         BadInput{"UnknownKeyFromSet", nullptr, "--set solver.iteratons=5", "solver.iteratons: unknown key"},
         BadInput{"NegativeSteps", nullptr, "--steps -1", "--steps"},

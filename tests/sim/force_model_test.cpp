@@ -58,7 +58,7 @@ std::complex<double> amplification(Integrator integrator, double omegaH) {
 }
 
 struct Oscillation {
-  double period;         // s, from crossings of the equilibrium
+  double period;          // s, from crossings of the equilibrium
   double firstAmplitude;  // m, largest |displacement| in the first period
   double lastAmplitude;   // m, in the last period
 };

@@ -22,7 +22,8 @@ TEST(Lattice, RestLengthsAreTheSpacing) {
     const bool horizontal = rest.restPositions[c.a].z == rest.restPositions[c.b].z;
     EXPECT_DOUBLE_EQ(c.restLength, 0.25) << horizontal;
   }
-  for (const DistanceConstraint& c : rest.of(ConstraintKind::shear)) EXPECT_DOUBLE_EQ(c.restLength, 0.25 * std::sqrt(2.0));
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::shear))
+    EXPECT_DOUBLE_EQ(c.restLength, 0.25 * std::sqrt(2.0));
   for (const DistanceConstraint& c : rest.of(ConstraintKind::bend)) EXPECT_DOUBLE_EQ(c.restLength, 0.5);
 }
 

@@ -107,7 +107,8 @@ TEST(PositionModel, PinnedParticlesNeverMove) {
   }
   // ...while the rest of the sheet has moved: on average more than 10 cm.
   Real travelled = 0.0;
-  for (std::size_t i = 0; i < start.size(); ++i) travelled += glm::length(world.cloths()[0].state.position[i] - start[i]);
+  for (std::size_t i = 0; i < start.size(); ++i)
+    travelled += glm::length(world.cloths()[0].state.position[i] - start[i]);
   EXPECT_GT(travelled, 0.1 * static_cast<Real>(start.size()));
 }
 

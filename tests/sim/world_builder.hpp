@@ -25,8 +25,7 @@ inline WorldSettings verticalSpring(Model model, Integrator integrator, double d
   world.solver.model = model;
   world.solver.integrator = integrator;
   world.solver.dt = dt;
-  ClothSettings cloth =
-      chainCloth(1, 2, 1.0, restLength, 2.0 * particleMass, top, LatticePlane::xy, {ks, 0.0});
+  ClothSettings cloth = chainCloth(1, 2, 1.0, restLength, 2.0 * particleMass, top, LatticePlane::xy, {ks, 0.0});
   cloth.pins.push_back({0, 0, std::nullopt});
   world.cloths.push_back(cloth);
   return world;

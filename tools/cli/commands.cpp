@@ -116,9 +116,10 @@ int run(const RunArguments& arguments) {
     sim::World world = makeWorld(scene);
     for (const std::string& file : arguments.outputs) outputKind(file);  // reject before running
     const double dt = scene.world.solver.dt;
-    const std::int64_t steps = arguments.steps ? *arguments.steps
-                                               : static_cast<std::int64_t>(std::ceil(
-                                                     (arguments.seconds ? *arguments.seconds : scene.duration) / dt - 1e-9));
+    const std::int64_t steps =
+        arguments.steps ? *arguments.steps
+                        : static_cast<std::int64_t>(
+                              std::ceil((arguments.seconds ? *arguments.seconds : scene.duration) / dt - 1e-9));
 
     std::optional<TraceTarget> target;
     std::ostringstream trace;
@@ -133,9 +134,10 @@ int run(const RunArguments& arguments) {
     for (std::int64_t i = 0; i < steps; ++i) {
       if (world.step() == sim::StepStatus::diverged) {
         const sim::Divergence& d = *world.divergence();
-        std::cerr << "drape-cli: error: " << scene.source << ": diverged at step " << d.step << " (t = "
-                  << static_cast<double>(d.step) * dt << " s): cloth " << d.cloth << " particle " << d.particle
-                  << " became non-finite or ran away past " << sim::kRunawayDistance << " m; nothing written\n";
+        std::cerr << "drape-cli: error: " << scene.source << ": diverged at step " << d.step
+                  << " (t = " << static_cast<double>(d.step) * dt << " s): cloth " << d.cloth << " particle "
+                  << d.particle << " became non-finite or ran away past " << sim::kRunawayDistance
+                  << " m; nothing written\n";
         return kExitDiverged;
       }
       if (target) appendTraceRow(trace, world, *target);
@@ -145,7 +147,7 @@ int run(const RunArguments& arguments) {
     std::vector<scene::OutputFile> files;
     for (const std::string& file : arguments.outputs) {
       files.push_back({file, outputKind(file) == OutputKind::state ? scene::stateDocument(scene, world).dump(1) + "\n"
-                                                                    : scene::objText(world)});
+                                                                   : scene::objText(world)});
     }
     if (arguments.traceOut) files.push_back({*arguments.traceOut, trace.str()});
     scene::writeFilesAtomically(files);
@@ -153,9 +155,11 @@ int run(const RunArguments& arguments) {
     if (!arguments.quiet) {
       const sim::StrainStats strain = sim::structuralStrain(world);
       const sim::Energy energy = sim::energy(world);
-      std::printf("%s: %lld steps (%.3f s simulated) in %.3f s; %zu particles; structural strain max %.2f %%, mean %.3f %%; energy %.4g J\n",
-                  scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds,
-                  countParticles(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
+      std::printf(
+          "%s: %lld steps (%.3f s simulated) in %.3f s; %zu particles; structural strain max %.2f %%, mean %.3f %%; "
+          "energy %.4g J\n",
+          scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds, countParticles(world),
+          100.0 * strain.max, 100.0 * strain.mean, energy.total());
       for (const scene::OutputFile& file : files) std::printf("wrote %s\n", file.path.c_str());
     }
     return kExitOk;

@@ -16,7 +16,7 @@ inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitInternal = 3;
 
 struct SceneArguments {
-  std::string scene;                  // path, or the name of a shipped scene
+  std::string scene;                   // path, or the name of a shipped scene
   std::vector<std::string> overrides;  // --set path=value
 };
 

@@ -12,7 +12,8 @@ int main(int argc, char** argv) {
 
   SceneArguments validateArguments;
   CLI::App* validateCommand = app.add_subcommand("validate", "Check a scene file; exit 0 if it is valid, 2 if not");
-  validateCommand->add_option("scene", validateArguments.scene, "Scene file, or the name of a shipped scene")->required();
+  validateCommand->add_option("scene", validateArguments.scene, "Scene file, or the name of a shipped scene")
+      ->required();
   validateCommand->add_option("--set", validateArguments.overrides, "Override a key: path=value (repeatable)");
 
   RunArguments runArguments;

@@ -21,8 +21,8 @@ std::string formatRange(const Range& range) {
 }
 
 void failAt(const std::string& source, const std::string& path, std::string_view expected, const nlohmann::json* got) {
-  std::string message = source + ": " + (path.empty() ? std::string("(document)") : path) + ": expected " +
-                        std::string(expected);
+  std::string message =
+      source + ": " + (path.empty() ? std::string("(document)") : path) + ": expected " + std::string(expected);
   message += got ? ", got " + describe(*got) : ", but it is missing";
   throw InputError(message);
 }

@@ -81,13 +81,12 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
   document["dt"] = world.settings().solver.dt;
   document["steps"] = world.stepCount();
   document["time"] = world.time();
-  document["metrics"] = {
-      {"strain", {{"max", strain.max}, {"mean", strain.mean}, {"constraints", strain.count}}},
-      {"energy",
-       {{"kinetic", energy.kinetic},
-        {"gravitational", energy.gravitational},
-        {"elastic", energy.elastic},
-        {"total", energy.total()}}}};
+  document["metrics"] = {{"strain", {{"max", strain.max}, {"mean", strain.mean}, {"constraints", strain.count}}},
+                         {"energy",
+                          {{"kinetic", energy.kinetic},
+                           {"gravitational", energy.gravitational},
+                           {"elastic", energy.elastic},
+                           {"total", energy.total()}}}};
   json cloths = json::array();
   for (const sim::Cloth& cloth : world.cloths()) {
     json positions = json::array();

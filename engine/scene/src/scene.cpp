@@ -46,8 +46,10 @@ KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model)
   if (!cloth.has(key)) return material;
   ObjectReader reader = cloth.object(key);
   if (model == Model::position) {
-    material.stiffness = reader.number("stiffness", material.stiffness, {0.0, 1.0, false, "fraction corrected per sweep"});
-    material.damping = reader.number("damping", material.damping, {0.0, 1.0, false, "fraction of relative velocity removed per substep"});
+    material.stiffness =
+        reader.number("stiffness", material.stiffness, {0.0, 1.0, false, "fraction corrected per sweep"});
+    material.damping = reader.number("damping", material.damping,
+                                     {0.0, 1.0, false, "fraction of relative velocity removed per substep"});
   } else {
     material.stiffness = reader.number("stiffness", material.stiffness, {0.0, 1.0e9, false, "N/m"});
     material.damping = reader.number("damping", material.damping, {0.0, 1.0e6, false, "N s/m"});
@@ -66,8 +68,8 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
   lattice.height = grid.number("height", 1.0, {0.0, 1000.0, true, "m"});
   const long long particles = static_cast<long long>(lattice.columns) * lattice.rows;
   if (particles > particleBudget) {
-    throw InputError(reader.source() + ": " + reader.pathOf("grid") + ": " + std::to_string(lattice.columns) +
-                     " x " + std::to_string(lattice.rows) + " particles pass the limit of " +
+    throw InputError(reader.source() + ": " + reader.pathOf("grid") + ": " + std::to_string(lattice.columns) + " x " +
+                     std::to_string(lattice.rows) + " particles pass the limit of " +
                      std::to_string(sim::kMaxParticles) + " particles over all cloths");
   }
   particleBudget -= particles;
@@ -82,8 +84,8 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
   const json& pins = reader.array("pins", kMaxPins);
   for (std::size_t i = 0; i < pins.size(); ++i) {
     ObjectReader pin(pins[i], reader.pathOf("pins") + "." + std::to_string(i), reader.source());
-    const std::string expected = "[column, row] inside the " + std::to_string(lattice.columns) + " x " +
-                                 std::to_string(lattice.rows) + " grid";
+    const std::string expected =
+        "[column, row] inside the " + std::to_string(lattice.columns) + " x " + std::to_string(lattice.rows) + " grid";
     const json* found = pin.raw("particle");
     if (!found) pin.fail("particle", expected, nullptr);
     const json& particle = *found;
@@ -160,7 +162,8 @@ void applyOverride(json& document, std::string_view assignment) {
   std::size_t begin = 0;
   while (true) {
     const std::size_t dot = path.find('.', begin);
-    const std::string_view segment = path.substr(begin, dot == std::string_view::npos ? path.size() - begin : dot - begin);
+    const std::string_view segment =
+        path.substr(begin, dot == std::string_view::npos ? path.size() - begin : dot - begin);
     if (segment.empty()) throw InputError(where + ": empty key in the path");
     json* next = nullptr;
     if (node->is_array()) {
@@ -185,9 +188,7 @@ void applyOverride(json& document, std::string_view assignment) {
   }
 }
 
-std::filesystem::path sceneDirectory() {
-  return std::filesystem::path(DRAPE_ASSET_DIR) / "scenes";
-}
+std::filesystem::path sceneDirectory() { return std::filesystem::path(DRAPE_ASSET_DIR) / "scenes"; }
 
 std::filesystem::path resolveScenePath(const std::string& nameOrPath) {
   const std::filesystem::path direct(nameOrPath);

@@ -36,11 +36,10 @@ void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, Partic
 }  // namespace
 
 ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
-  if (spec.columns < 1 || spec.rows < 1 || spec.columns > kMaxLatticeSide ||
-      spec.rows > kMaxLatticeSide ||
+  if (spec.columns < 1 || spec.rows < 1 || spec.columns > kMaxLatticeSide || spec.rows > kMaxLatticeSide ||
       static_cast<long long>(spec.columns) * spec.rows > kMaxParticles) {
-    throw std::invalid_argument("lattice of " + std::to_string(spec.columns) + " x " +
-                                std::to_string(spec.rows) + " particles is outside the limits");
+    throw std::invalid_argument("lattice of " + std::to_string(spec.columns) + " x " + std::to_string(spec.rows) +
+                                " particles is outside the limits");
   }
   if (!(spec.width > 0.0) || !(spec.height > 0.0)) {
     throw std::invalid_argument("lattice width and height must be positive");

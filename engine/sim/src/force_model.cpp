@@ -28,7 +28,8 @@ void accelerations(const Cloth& cloth, const WorldSettings& world, const std::ve
       const Real doubleArea = glm::length(doubleAreaNormal);
       if (!(doubleArea > 0.0)) continue;
       const Vec3 velocity = (v[t.x] + v[t.y] + v[t.z]) / 3.0;
-      const Vec3 force = doubleAreaNormal * (air.pressure * 0.5 * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
+      const Vec3 force =
+          doubleAreaNormal * (air.pressure * 0.5 * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
       for (int corner = 0; corner < 3; ++corner) a[t[corner]] += force * (w[t[corner]] / 3.0);
     }
   }
@@ -69,7 +70,8 @@ void symplecticEuler(Cloth& cloth, const WorldSettings& world, Real h, SolverScr
 void verlet(Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   const Real inverseH = 1.0 / h;
-  for (std::size_t i = 0; i < s.position.size(); ++i) s.velocity[i] = (s.position[i] - s.previousPosition[i]) * inverseH;
+  for (std::size_t i = 0; i < s.position.size(); ++i)
+    s.velocity[i] = (s.position[i] - s.previousPosition[i]) * inverseH;
   accelerations(cloth, world, s.position, s.velocity, scratch.acceleration);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
     const Vec3 x = s.position[i];

@@ -46,7 +46,8 @@ Energy energy(const World& world) {
       const double ks = cloth.settings.material(kind).stiffness;
       for (const DistanceConstraint& con : cloth.rest.of(kind)) {
         const double stretch =
-            static_cast<double>(glm::length(cloth.state.position[con.b] - cloth.state.position[con.a])) - con.restLength;
+            static_cast<double>(glm::length(cloth.state.position[con.b] - cloth.state.position[con.a])) -
+            con.restLength;
         e.elastic += 0.5 * ks * stretch * stretch;
       }
     }
@@ -63,8 +64,7 @@ std::vector<Vec3> vertexNormals(const Cloth& cloth) {
     normals[t.y] += n;
     normals[t.z] += n;
   }
-  const Vec3 planeNormal =
-      cloth.settings.lattice.plane == LatticePlane::xz ? Vec3{0.0, 1.0, 0.0} : Vec3{0.0, 0.0, 1.0};
+  const Vec3 planeNormal = cloth.settings.lattice.plane == LatticePlane::xz ? Vec3{0.0, 1.0, 0.0} : Vec3{0.0, 0.0, 1.0};
   for (Vec3& n : normals) {
     const Real length = glm::length(n);
     n = length > 0.0 ? n / length : planeNormal;

@@ -15,8 +15,7 @@ void startHistory(Cloth& cloth, Vec3 initialAcceleration, Real h) {
   }
 }
 
-void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h,
-                            std::vector<Vec3>& acceleration) {
+void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, std::vector<Vec3>& acceleration) {
   const ParticleState& s = cloth.state;
   std::fill(acceleration.begin(), acceleration.end(), Vec3{0.0});
   const Real inverseH = 1.0 / h;
@@ -24,11 +23,12 @@ void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h,
     const Vec3 doubleAreaNormal = glm::cross(s.position[t.y] - s.position[t.x], s.position[t.z] - s.position[t.x]);
     const Real doubleArea = glm::length(doubleAreaNormal);
     if (!(doubleArea > 0.0)) continue;  // a degenerate triangle feels no pressure
-    const Vec3 velocity = (s.position[t.x] - s.previousPosition[t.x] + s.position[t.y] -
-                           s.previousPosition[t.y] + s.position[t.z] - s.previousPosition[t.z]) *
+    const Vec3 velocity = (s.position[t.x] - s.previousPosition[t.x] + s.position[t.y] - s.previousPosition[t.y] +
+                           s.position[t.z] - s.previousPosition[t.z]) *
                           (inverseH / 3.0);
     // pressure * area * (relative . n) n  with area = |N| / 2 and n = N / |N|
-    const Vec3 force = doubleAreaNormal * (air.pressure * 0.5 * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
+    const Vec3 force =
+        doubleAreaNormal * (air.pressure * 0.5 * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
     for (int corner = 0; corner < 3; ++corner) {
       const ParticleIndex p = t[corner];
       acceleration[p] += force * (s.inverseMass[p] / 3.0);
@@ -54,8 +54,8 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
   }
 }
 
-void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inverseMass,
-                     const DistanceConstraint& c, Real stiffness) {
+void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inverseMass, const DistanceConstraint& c,
+                     Real stiffness) {
   const Real wa = inverseMass[c.a], wb = inverseMass[c.b];
   const Real wSum = wa + wb;
   if (wSum == 0.0) return;
@@ -95,7 +95,8 @@ void dampConstraints(Cloth& cloth) {
       if (!(length > 1e-10)) continue;
       const Vec3 n = d / length;
       // relative displacement over the substep along n (velocity times h)
-      const Real relative = glm::dot((s.position[c.b] - s.previousPosition[c.b]) - (s.position[c.a] - s.previousPosition[c.a]), n);
+      const Real relative =
+          glm::dot((s.position[c.b] - s.previousPosition[c.b]) - (s.position[c.a] - s.previousPosition[c.a]), n);
       const Real impulse = damping * relative / wSum;
       s.previousPosition[c.a] -= (wa * impulse) * n;
       s.previousPosition[c.b] += (wb * impulse) * n;

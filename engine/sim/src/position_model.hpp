@@ -16,8 +16,7 @@ void startHistory(Cloth& cloth, Vec3 initialAcceleration, Real h);
 
 // Adds the aerodynamic force on every triangle to `acceleration` (zeroed first):
 // f = pressure * area * ((wind - v) . n) n, shared equally by the triangle's three particles.
-void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h,
-                            std::vector<Vec3>& acceleration);
+void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, std::vector<Vec3>& acceleration);
 
 // x' = x + (x - x_prev) e^{-kh} + a h^2 (1 - e^{-kh}) / (kh),  k = damping + drag,
 // a = g + drag wind + a_extra. With k = 0 this is the seed's Verlet step; with k > 0 it is the exact

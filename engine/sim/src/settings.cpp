@@ -7,12 +7,11 @@ namespace drape::sim {
 namespace {
 constexpr std::array kModelNames = {std::pair{Model::position, std::string_view{"position"}},
                                     std::pair{Model::force, std::string_view{"force"}}};
-constexpr std::array kIntegratorNames = {
-    std::pair{Integrator::explicitEuler, std::string_view{"explicit-euler"}},
-    std::pair{Integrator::symplecticEuler, std::string_view{"symplectic-euler"}},
-    std::pair{Integrator::verlet, std::string_view{"verlet"}},
-    std::pair{Integrator::midpoint, std::string_view{"midpoint"}},
-    std::pair{Integrator::rk4, std::string_view{"rk4"}}};
+constexpr std::array kIntegratorNames = {std::pair{Integrator::explicitEuler, std::string_view{"explicit-euler"}},
+                                         std::pair{Integrator::symplecticEuler, std::string_view{"symplectic-euler"}},
+                                         std::pair{Integrator::verlet, std::string_view{"verlet"}},
+                                         std::pair{Integrator::midpoint, std::string_view{"midpoint"}},
+                                         std::pair{Integrator::rk4, std::string_view{"rk4"}}};
 
 template <typename Table, typename Enum>
 std::string_view lookupName(const Table& table, Enum value) {

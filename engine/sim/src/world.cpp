@@ -176,8 +176,9 @@ std::optional<Divergence> World::findBadParticle() const {
     const ParticleState& s = cloths_[c].state;
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       const Vec3 x = s.position[i];
-      const bool bad = !finite(x) || !(glm::abs(x.x) <= kRunawayDistance && glm::abs(x.y) <= kRunawayDistance &&
-                                       glm::abs(x.z) <= kRunawayDistance) ||
+      const bool bad = !finite(x) ||
+                       !(glm::abs(x.x) <= kRunawayDistance && glm::abs(x.y) <= kRunawayDistance &&
+                         glm::abs(x.z) <= kRunawayDistance) ||
                        (!s.velocity.empty() && !finite(s.velocity[i])) || !finite(s.previousPosition[i]);
       if (bad) return Divergence{stepCount_ + 1, static_cast<int>(c), static_cast<ParticleIndex>(i)};
     }

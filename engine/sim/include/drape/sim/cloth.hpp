@@ -38,25 +38,23 @@ enum class LatticePlane : std::uint8_t {
 std::string_view name(LatticePlane plane);
 
 struct LatticeSpec {
-  int columns = 2;                 // particles along a row, >= 1
-  int rows = 2;                    // particles along a column, >= 1 (1 makes a chain)
-  Real width = 1.0;              // m, distance from column 0 to the last column
-  Real height = 1.0;             // m, distance from row 0 to the last row
-  Vec3 origin{0.0};               // m, rest position of particle (column 0, row 0)
+  int columns = 2;    // particles along a row, >= 1
+  int rows = 2;       // particles along a column, >= 1 (1 makes a chain)
+  Real width = 1.0;   // m, distance from column 0 to the last column
+  Real height = 1.0;  // m, distance from row 0 to the last row
+  Vec3 origin{0.0};   // m, rest position of particle (column 0, row 0)
   LatticePlane plane = LatticePlane::xz;
 };
 
 struct ClothRest {
   int columns = 0;
   int rows = 0;
-  std::vector<Vec3> restPositions;          // m, index = row * columns + column
-  std::vector<glm::uvec3> triangles;        // counter-clockwise seen from the front (+y or +z)
+  std::vector<Vec3> restPositions;    // m, index = row * columns + column
+  std::vector<glm::uvec3> triangles;  // counter-clockwise seen from the front (+y or +z)
   std::array<std::vector<DistanceConstraint>, kConstraintKindCount> constraints;  // by kind
 
   std::size_t particleCount() const { return restPositions.size(); }
-  ParticleIndex index(int column, int row) const {
-    return static_cast<ParticleIndex>(row * columns + column);
-  }
+  ParticleIndex index(int column, int row) const { return static_cast<ParticleIndex>(row * columns + column); }
   const std::vector<DistanceConstraint>& of(ConstraintKind kind) const {
     return constraints[static_cast<std::size_t>(kind)];
   }

@@ -37,15 +37,15 @@ struct SolverSettings {
   double dt = 1.0 / 60.0;                      // s, one step
   int substeps = 1;                            // each step is split into this many equal substeps
   int iterations = 20;                         // position model: constraint sweeps per substep
-  Real damping = 0.0;                        // 1/s, global velocity damping: a -= damping * v
+  Real damping = 0.0;                          // 1/s, global velocity damping: a -= damping * v
 };
 
 // The air around the cloth, moving uniformly at `velocity`.
 struct AirSettings {
   Vec3 velocity{0.0};   // m/s, the wind
-  Real drag = 0.0;     // 1/s, linear drag towards the air's velocity: a -= drag * (v - wind)
-  Real pressure = 0.0; // kg/(m^2 s), force on a triangle along its normal:
-                         //   f = pressure * area * ((wind - v) . n) n   (what makes a flag flutter)
+  Real drag = 0.0;      // 1/s, linear drag towards the air's velocity: a -= drag * (v - wind)
+  Real pressure = 0.0;  // kg/(m^2 s), force on a triangle along its normal:
+                        //   f = pressure * area * ((wind - v) . n) n   (what makes a flag flutter)
 };
 
 // How one constraint kind resists. Units depend on the model:
@@ -66,15 +66,13 @@ struct Pin {
 
 struct ClothSettings {
   LatticeSpec lattice;
-  Real mass = 1.0;  // kg, spread evenly over the particles
+  Real mass = 1.0;            // kg, spread evenly over the particles
   Vec3 initialVelocity{0.0};  // m/s, of every unpinned particle at the start
   std::array<KindMaterial, kConstraintKindCount> materials{};
   std::vector<Pin> pins;
 
   KindMaterial& material(ConstraintKind kind) { return materials[static_cast<std::size_t>(kind)]; }
-  const KindMaterial& material(ConstraintKind kind) const {
-    return materials[static_cast<std::size_t>(kind)];
-  }
+  const KindMaterial& material(ConstraintKind kind) const { return materials[static_cast<std::size_t>(kind)]; }
 };
 
 struct WorldSettings {

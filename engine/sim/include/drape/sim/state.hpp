@@ -12,7 +12,7 @@ struct ParticleState {
   std::vector<Vec3> position;          // m
   std::vector<Vec3> previousPosition;  // m, position one substep ago (Verlet's velocity-less memory)
   std::vector<Vec3> velocity;          // m/s, force model only; empty in the position model
-  std::vector<Real> inverseMass;      // 1/kg; 0 for a pinned particle, which nothing moves
+  std::vector<Real> inverseMass;       // 1/kg; 0 for a pinned particle, which nothing moves
 };
 
 }  // namespace drape::sim
@@ -22,11 +22,11 @@ namespace drape::sim {
 // Per-cloth working arrays of the solver, sized once when the world is made and only for the
 // stages that need them (empty otherwise).
 struct SolverScratch {
-  std::vector<Vec3> acceleration;  // m/s^2: wind pressure (position model), a(x, v) (force model)
-  std::vector<Vec3> trialPosition;   // force model, multi-stage integrators: x at a trial point
-  std::vector<Vec3> trialVelocity;   // ... and v there
-  std::vector<Vec3> sumPosition;     // rk4: weighted sum of the stages' dx/dt
-  std::vector<Vec3> sumVelocity;     // rk4: weighted sum of the stages' dv/dt
+  std::vector<Vec3> acceleration;   // m/s^2: wind pressure (position model), a(x, v) (force model)
+  std::vector<Vec3> trialPosition;  // force model, multi-stage integrators: x at a trial point
+  std::vector<Vec3> trialVelocity;  // ... and v there
+  std::vector<Vec3> sumPosition;    // rk4: weighted sum of the stages' dx/dt
+  std::vector<Vec3> sumVelocity;    // rk4: weighted sum of the stages' dv/dt
 };
 
 }  // namespace drape::sim

@@ -63,8 +63,8 @@ class World {
   std::int64_t stepCount_ = 0;
   bool historyStarted_ = false;
   std::optional<Divergence> divergence_;
-  std::vector<SolverScratch> scratch_;               // per cloth
-  std::vector<ParticleState> lastGood_;               // state before the current step
+  std::vector<SolverScratch> scratch_;   // per cloth
+  std::vector<ParticleState> lastGood_;  // state before the current step
 };
 
 }  // namespace drape::sim
