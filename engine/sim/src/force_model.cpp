@@ -1,5 +1,7 @@
 #include "force_model.hpp"
 
+#include "aerodynamics.hpp"
+
 #include <glm/geometric.hpp>
 
 namespace drape::sim::force {
@@ -23,15 +25,8 @@ void accelerations(const Cloth& cloth, const WorldSettings& world, const std::ve
     a[i] = w[i] > 0.0 ? constant - linearDamping * v[i] : Vec3{0.0};
   }
   if (air.pressure > 0.0) {
-    for (const glm::uvec3& t : cloth.rest.triangles) {
-      const Vec3 doubleAreaNormal = glm::cross(x[t.y] - x[t.x], x[t.z] - x[t.x]);
-      const Real doubleArea = glm::length(doubleAreaNormal);
-      if (!(doubleArea > 0.0)) continue;
-      const Vec3 velocity = (v[t.x] + v[t.y] + v[t.z]) / 3.0;
-      const Vec3 force =
-          doubleAreaNormal * (air.pressure * 0.5 * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
-      for (int corner = 0; corner < 3; ++corner) a[t[corner]] += force * (w[t[corner]] / 3.0);
-    }
+    addWindPressure(
+        cloth.rest, x, w, air, [&](ParticleIndex p) { return v[p]; }, a);
   }
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);

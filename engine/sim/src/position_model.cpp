@@ -1,5 +1,7 @@
 #include "position_model.hpp"
 
+#include "aerodynamics.hpp"
+
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -19,21 +21,9 @@ void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, 
   const ParticleState& s = cloth.state;
   std::fill(acceleration.begin(), acceleration.end(), Vec3{0.0});
   const Real inverseH = 1.0 / h;
-  for (const glm::uvec3& t : cloth.rest.triangles) {
-    const Vec3 doubleAreaNormal = glm::cross(s.position[t.y] - s.position[t.x], s.position[t.z] - s.position[t.x]);
-    const Real doubleArea = glm::length(doubleAreaNormal);
-    if (!(doubleArea > 0.0)) continue;  // a degenerate triangle feels no pressure
-    const Vec3 velocity = (s.position[t.x] - s.previousPosition[t.x] + s.position[t.y] - s.previousPosition[t.y] +
-                           s.position[t.z] - s.previousPosition[t.z]) *
-                          (inverseH / 3.0);
-    // pressure * area * (relative . n) n  with area = |N| / 2 and n = N / |N|
-    const Vec3 force =
-        doubleAreaNormal * (air.pressure * 0.5 * glm::dot(air.velocity - velocity, doubleAreaNormal) / doubleArea);
-    for (int corner = 0; corner < 3; ++corner) {
-      const ParticleIndex p = t[corner];
-      acceleration[p] += force * (s.inverseMass[p] / 3.0);
-    }
-  }
+  addWindPressure(
+      cloth.rest, s.position, s.inverseMass, air,
+      [&](ParticleIndex p) { return (s.position[p] - s.previousPosition[p]) * inverseH; }, acceleration);
 }
 
 void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration) {
