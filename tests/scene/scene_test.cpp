@@ -1,10 +1,13 @@
 // Scene files: the shipped scenes, overrides, and what the reader refuses.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "drape/scene/error.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 
 namespace drape::scene {
@@ -24,6 +27,19 @@ TEST(ShippedScenes, AllLoadAndBuildAWorld) {
     ++count;
   }
   EXPECT_GE(count, 3);
+}
+
+TEST(ShippedScenes, RunTheirWholeDurationWithoutDivergingOrTearingApart) {
+  for (const auto& entry : std::filesystem::directory_iterator(sceneDirectory())) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Scene scene = loadScene(entry.path());
+    sim::World world(scene.world);
+    const auto steps = static_cast<std::int64_t>(std::ceil(scene.duration / scene.world.solver.dt));
+    ASSERT_EQ(world.run(steps), sim::StepStatus::ok);
+    // No structural edge ends more than a quarter longer than its rest length.
+    EXPECT_LT(sim::structuralStrain(world).max, 0.25);
+  }
 }
 
 TEST(ShippedScenes, ResolveByName) {
