@@ -126,9 +126,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadScene{"clothes=[]", "s.json: clothes: unknown key"},
         BadScene{"cloths.0.grid.colums=3", "s.json: cloths.0.grid.colums: unknown key"},
-        BadScene{"solver.dt=fast", "s.json: solver.dt: expected a number > 0 and <= 1 (s), got \"fast\""},
-        BadScene{"solver.dt=0", "s.json: solver.dt: expected a number > 0 and <= 1 (s), got 0"},
-        BadScene{"cloths.0.mass=-1", "s.json: cloths.0.mass: expected a number > 0 and <= 1000000 (kg), got -1"},
+        BadScene{"solver.dt=fast", "s.json: solver.dt: expected a number >= 1e-06 and <= 1 (s), got \"fast\""},
+        BadScene{"solver.dt=0", "s.json: solver.dt: expected a number >= 1e-06 and <= 1 (s), got 0"},
+        BadScene{"cloths.0.mass=-1", "s.json: cloths.0.mass: expected a number >= 1e-06 and <= 1000000 (kg), got -1"},
         BadScene{"cloths.0.grid.width=0", "s.json: cloths.0.grid.width: expected a number > 0 and <= 1000 (m), got 0"},
         BadScene{"cloths.0.grid.columns=2.5",
                  "s.json: cloths.0.grid.columns: expected an integer from 1 to 4096, got 2.5"},
@@ -156,7 +156,7 @@ TEST(SceneErrors, NonFiniteNumbersAreRefused) {
   json document = minimal();
   document["solver"]["dt"] = std::numeric_limits<double>::infinity();
   EXPECT_EQ(errorOf([&] { parseScene(document, "s.json"); }),
-            "s.json: solver.dt: expected a number > 0 and <= 1 (s), got a non-finite number");
+            "s.json: solver.dt: expected a number >= 1e-06 and <= 1 (s), got a non-finite number");
   document = minimal();
   document["gravity"] = {0.0, std::nan(""), 0.0};
   EXPECT_NE(errorOf([&] { parseScene(document, "s.json"); }).find("s.json: gravity: expected [x, y, z]"),

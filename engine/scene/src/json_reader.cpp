@@ -7,7 +7,7 @@ namespace drape::scene {
 
 std::string describe(const nlohmann::json& value) {
   if (value.is_number_float() && !std::isfinite(value.get<double>())) return "a non-finite number";
-  std::string text = value.dump();
+  std::string text = value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return text;
 }

@@ -1,6 +1,7 @@
 #include "drape/scene/scene.hpp"
 
 #include <charconv>
+#include <set>
 #include <fstream>
 #include <sstream>
 
@@ -77,7 +78,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
 
   lattice.origin = reader.vec3("origin", sim::Vec3{0.0}, kMaxCoordinate, "m");
   lattice.plane = reader.choice("plane", "xz", {"xz", "xy"}) == "xz" ? sim::LatticePlane::xz : sim::LatticePlane::xy;
-  cloth.mass = reader.number("mass", 1.0, {0.0, 1.0e6, true, "kg"});
+  cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
   cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
   for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model);
 
@@ -123,7 +124,7 @@ Scene parseScene(const json& document, const std::string& source) {
       solver.fail("integrator", "\"verlet\" for the position model (the others belong to \"model\": \"force\")",
                   solver.raw("integrator"));
     }
-    world.solver.dt = solver.number("dt", world.solver.dt, {0.0, 1.0, true, "s"});
+    world.solver.dt = solver.number("dt", world.solver.dt, {1.0e-6, 1.0, false, "s"});
     world.solver.substeps = solver.integer("substeps", world.solver.substeps, 1, sim::kMaxSubsteps);
     world.solver.iterations = solver.integer("iterations", world.solver.iterations, 0, sim::kMaxIterations);
     world.solver.damping = solver.number("damping", 0.0, {0.0, 1000.0, false, "1/s"});
@@ -208,8 +209,19 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
   std::ostringstream text;
   text << in.rdbuf();
   json document;
+  // JSON allows a key twice in one object and keeps the last; a scene file that does so has a
+  // mistake in it, so it is refused rather than silently half-read.
+  std::vector<std::set<std::string>> keysSeen;
+  const json::parser_callback_t rejectDuplicateKeys = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keysSeen.emplace_back();
+    if (event == json::parse_event_t::object_end && !keysSeen.empty()) keysSeen.pop_back();
+    if (event == json::parse_event_t::key && !keysSeen.empty() && !keysSeen.back().insert(parsed.get<std::string>()).second) {
+      throw InputError(source + ": key " + describe(parsed) + " appears twice in one object");
+    }
+    return true;
+  };
   try {
-    document = json::parse(text.str());
+    document = json::parse(text.str(), rejectDuplicateKeys);
   } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
     // nlohmann's message: "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
     // nlohmann's messages start with a tag: "[json.exception.parse_error.101] parse error at line 3, ..."

@@ -1,5 +1,6 @@
 #include "drape/sim/cloth.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -41,7 +42,7 @@ ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
     throw std::invalid_argument("lattice of " + std::to_string(spec.columns) + " x " + std::to_string(spec.rows) +
                                 " particles is outside the limits");
   }
-  if (!(spec.width > 0.0) || !(spec.height > 0.0)) {
+  if (!(spec.width > 0.0) || !(spec.height > 0.0) || !std::isfinite(spec.width) || !std::isfinite(spec.height)) {
     throw std::invalid_argument("lattice width and height must be positive");
   }
 

@@ -8,12 +8,22 @@
 
 namespace drape::sim::position {
 
-void startHistory(Cloth& cloth, Vec3 initialAcceleration, Real h) {
+namespace {
+// (1 - e^{-kh}) / (kh), the weight of a constant acceleration in the damped Verlet step; 1 at k = 0.
+Real relaxation(Real kh) { return kh > 0.0 ? -std::expm1(-kh) / kh : 1.0; }
+}  // namespace
+
+void startHistory(Cloth& cloth, Vec3 acceleration, Real k, Real h) {
   ParticleState& s = cloth.state;
+  const Vec3 v0 = cloth.settings.initialVelocity;
+  // Exact displacement over [0, h] of du/dt = a - k u, u(0) = v0: a h^2 / 2 + v0 h when k = 0.
+  const Real kh = k * h;
+  const Vec3 displacement = kh > 0.0 ? acceleration / k * h + (v0 - acceleration / k) * (h * relaxation(kh))
+                                     : v0 * h + 0.5 * acceleration * h * h;
+  // Choose x_prev so that the first step, x1 = x0 + (x0 - x_prev) e^{-kh} + a h^2 relaxation, moves exactly that far.
+  const Vec3 back = (displacement - acceleration * (h * h * relaxation(kh))) * std::exp(kh);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
-    s.previousPosition[i] = s.inverseMass[i] > 0.0
-                                ? s.position[i] - cloth.settings.initialVelocity * h + 0.5 * initialAcceleration * h * h
-                                : s.position[i];
+    s.previousPosition[i] = s.inverseMass[i] > 0.0 ? s.position[i] - back : s.position[i];
   }
 }
 
@@ -31,7 +41,7 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
   // Exact for du/dt = a - k u over one substep: u' = u e^{-kh} + a h (1 - e^{-kh}) / (k h).
   const Real kh = (world.solver.damping + world.air.drag) * h;
   const Real decay = std::exp(-kh);
-  const Real relaxed = kh > 0.0 ? -std::expm1(-kh) / kh : 1.0;
+  const Real relaxed = relaxation(kh);
   const Vec3 constantAcceleration = world.gravity + world.air.drag * world.air.velocity;
   const Real h2 = h * h * relaxed;
   for (std::size_t i = 0; i < s.position.size(); ++i) {

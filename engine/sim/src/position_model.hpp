@@ -9,10 +9,12 @@
 
 namespace drape::sim::position {
 
-// Verlet needs x_prev at t = -h. A Taylor start, x_prev = x - v0 h + a0 h^2 / 2, makes Verlet
-// reproduce x0 + v0 t + a t^2 / 2 exactly under constant acceleration; x_prev = x would instead
-// start the cloth with a spurious velocity of a h / 2.
-void startHistory(Cloth& cloth, Vec3 initialAcceleration, Real h);
+// Verlet needs x_prev at t = -h. It is chosen so that the first step moves a free particle exactly
+// as du/dt = a - k u, u(0) = v0 would (k = damping + drag, a = g + drag wind); since integrate() is
+// exact for that equation step to step, the whole trajectory of a free particle is then exact.
+// With k = 0 this is the Taylor start x_prev = x - v0 h + a h^2 / 2, which makes Verlet reproduce
+// x0 + v0 t + a t^2 / 2; x_prev = x would start the cloth with a spurious velocity of a h / 2.
+void startHistory(Cloth& cloth, Vec3 acceleration, Real k, Real h);
 
 // Adds the aerodynamic force on every triangle to `acceleration` (zeroed first):
 // f = pressure * area * ((wind - v) . n) n, shared equally by the triangle's three particles.

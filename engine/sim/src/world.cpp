@@ -1,5 +1,6 @@
 #include "drape/sim/world.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -26,6 +27,7 @@ void validate(const WorldSettings& s) {
   const SolverSettings& solver = s.solver;
   require(std::isfinite(solver.dt) && solver.dt > 0.0, "solver.dt must be a positive number of seconds");
   require(solver.substeps >= 1 && solver.substeps <= kMaxSubsteps, "solver.substeps is out of range");
+  require(solver.dt / solver.substeps >= 1e-9, "the substep dt / substeps must be at least 1e-9 s");
   require(solver.iterations >= 0 && solver.iterations <= kMaxIterations, "solver.iterations is out of range");
   require(finite(solver.damping) && solver.damping >= 0.0, "solver.damping must be finite and >= 0");
   require(finite(s.gravity), "gravity must be finite");
@@ -36,6 +38,9 @@ void validate(const WorldSettings& s) {
   for (const ClothSettings& cloth : s.cloths) {
     particles += static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
     require(finite(cloth.mass) && cloth.mass > 0.0, "cloth mass must be positive");
+    const Real clothParticles = static_cast<Real>(cloth.lattice.columns) * cloth.lattice.rows;
+    require(std::isfinite(clothParticles / cloth.mass) && cloth.mass / clothParticles > 0.0,
+            "cloth mass per particle must be a positive number with a finite inverse");
     require(finite(cloth.lattice.origin), "cloth origin must be finite");
     require(finite(cloth.initialVelocity), "cloth velocity must be finite");
     for (const KindMaterial& m : cloth.materials) {
@@ -95,7 +100,13 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
 
 }  // namespace
 
-World::World(WorldSettings settings) : settings_(std::move(settings)) {
+std::uint64_t nextTopologyVersion() {
+  // Process-wide so that two worlds never share a version; it never influences the simulation.
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+
+World::World(WorldSettings settings) : settings_(std::move(settings)), topologyVersion_(nextTopologyVersion()) {
   validate(settings_);
   const Model model = settings_.solver.model;
   bool anyTriangles = false, anyProjected = false, anyDamped = false;
@@ -141,7 +152,8 @@ void World::startHistory() {
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     if (settings_.solver.model == Model::position) {
       if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(cloths_[c].state.position.size(), Vec3{0.0});
-      position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity, h);
+      position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity,
+                             settings_.solver.damping + settings_.air.drag, h);
     } else {
       force::startHistory(cloths_[c], settings_, h, scratch_[c]);
     }
@@ -179,7 +191,7 @@ std::optional<Divergence> World::findBadParticle() const {
       const bool bad = !finite(x) ||
                        !(glm::abs(x.x) <= kRunawayDistance && glm::abs(x.y) <= kRunawayDistance &&
                          glm::abs(x.z) <= kRunawayDistance) ||
-                       (!s.velocity.empty() && !finite(s.velocity[i])) || !finite(s.previousPosition[i]);
+                       (!s.velocity.empty() && !(glm::length(s.velocity[i]) <= kRunawaySpeed)) || !finite(s.previousPosition[i]);
       if (bad) return Divergence{stepCount_ + 1, static_cast<int>(c), static_cast<ParticleIndex>(i)};
     }
   }

@@ -9,7 +9,16 @@ namespace drape::scene {
 
 class InputError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  // Control characters (a key or file name with a newline in it) become '?': one line, always.
+  explicit InputError(const std::string& message) : std::runtime_error(oneLine(message)) {}
+
+ private:
+  static std::string oneLine(std::string text) {
+    for (char& c : text) {
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+    }
+    return text;
+  }
 };
 
 }  // namespace drape::scene

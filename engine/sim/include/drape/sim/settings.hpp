@@ -89,5 +89,6 @@ inline constexpr int kMaxSubsteps = 1000;
 inline constexpr int kMaxIterations = 10000;
 // A particle farther than this from the origin is a runaway: the guard treats it like NaN.
 inline constexpr Real kRunawayDistance = 1.0e6;  // m
+inline constexpr Real kRunawaySpeed = 1.0e6;     // m/s, likewise for a stored velocity
 
 }  // namespace drape::sim

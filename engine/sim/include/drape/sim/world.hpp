@@ -48,6 +48,9 @@ class World {
   const std::optional<Divergence>& divergence() const { return divergence_; }
   const Profile& profile() const { return profile_; }
   bool hasStage(Stage stage) const;
+  // Changes whenever the set of cloths or any cloth's triangles or constraints change (tearing,
+  // cutting, spawning), and differs between worlds: a renderer re-uploads index buffers only then.
+  std::uint64_t topologyVersion() const { return topologyVersion_; }
 
   // Velocity of a particle, m/s: stored in the force model, (x - x_prev) / h in the position model.
   Vec3 velocity(int cloth, ParticleIndex particle) const;
@@ -61,6 +64,7 @@ class World {
   std::vector<Cloth> cloths_;
   Profile profile_;
   std::int64_t stepCount_ = 0;
+  std::uint64_t topologyVersion_ = 0;
   bool historyStarted_ = false;
   std::optional<Divergence> divergence_;
   std::vector<SolverScratch> scratch_;   // per cloth
