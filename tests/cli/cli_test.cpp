@@ -192,11 +192,11 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadInput{"MalformedJson", R"({"cloths": [)", "", "bad.json: malformed JSON: parse error at line 1"},
         BadInput{"UnknownKey", R"({"cloths": [], "colour": 3})", "", "bad.json: colour: unknown key"},
-        BadInput{"WrongType", R"({"solver": {"dt": "small"}})", "", "bad.json: solver.dt: expected a number > 0"},
+        BadInput{"WrongType", R"({"solver": {"dt": "small"}})", "", "bad.json: solver.dt: expected a number >= 1e-06"},
         BadInput{"NegativeMass", R"({"cloths": [{"grid": {}, "mass": -2}]})", "", "bad.json: cloths.0.mass: expected"},
         BadInput{"ZeroSize", R"({"cloths": [{"grid": {"height": 0}}]})", "",
                  "bad.json: cloths.0.grid.height: expected"},
-        BadInput{"ZeroDt", R"({"solver": {"dt": 0}})", "", "bad.json: solver.dt: expected a number > 0"},
+        BadInput{"ZeroDt", R"({"solver": {"dt": 0}})", "", "bad.json: solver.dt: expected a number >= 1e-06"},
         BadInput{"TooManyParticles", R"({"cloths": [{"grid": {"columns": 4096, "rows": 4096}}]})", "",
                  "particles pass the limit of 1048576"},
         BadInput{"PinOutsideGrid",
@@ -205,7 +205,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"InfiniteNumber", R"({"gravity": [0, -1e999, 0]})", "", "bad.json: malformed JSON: number overflow"},
         BadInput{"NotAnObject", R"([1, 2, 3])", "", "bad.json: (document): expected an object"},
         BadInput{"NaNFromSet", nullptr, "--set solver.dt=nan",
-                 "solver.dt: expected a number > 0 and <= 1 (s), got \"nan\""},
+                 "solver.dt: expected a number >= 1e-06 and <= 1 (s), got \"nan\""},
         BadInput{"BadSetPath", nullptr, "--set cloths.4.mass=1", "--set cloths.4.mass=1: 4 is not an index"},
         BadInput{"UnknownKeyFromSet", nullptr, "--set solver.iteratons=5", "solver.iteratons: unknown key"},
         BadInput{"NegativeSteps", nullptr, "--steps -1", "--steps"},
@@ -215,8 +215,56 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"UnwritableOutput", nullptr, "--out /nonexistent-dir/s.json", "/nonexistent-dir/s.json: cannot write"},
         BadInput{"TraceOutsideGrid", nullptr, "--trace 9,0 --trace-out t.csv", "--trace 9,0: outside the 4 x 3 grid"},
         BadInput{"TraceNotNumbers", nullptr, "--trace a,b --trace-out t.csv", "--trace a,b: expected column,row"},
-        BadInput{"TraceWithoutOut", nullptr, "--trace 0,0", "--trace"}),
+        BadInput{"TraceWithoutOut", nullptr, "--trace 0,0", "--trace"},
+        BadInput{"DuplicateKey", R"({"solver": {"dt": 0.01, "dt": 0.5}})", "", "bad.json: key \"dt\" appears twice"},
+        BadInput{"KeyWithNewline", "{\"a\\nb\": 1}", "", "bad.json: a?b: unknown key"},
+        BadInput{"TinyMass", nullptr, "--set cloths.0.mass=1e-310", "cloths.0.mass: expected a number >= 1e-06"},
+        BadInput{"SameOutputTwice", nullptr, "--out s2.json --out ./s2.json", "s2.json: named as an output twice"},
+        BadInput{"InvalidUtf8", nullptr, "--set \"solver.model=$(printf '\\377')\"", "solver.model: expected one of"}),
     [](const auto& testInfo) { return std::string(testInfo.param.name); });
+
+TEST_F(Cli, RenderWritesAPngOfTheRequestedSize) {
+  const fs::path picture = file("hang.png");
+  const Result result = run("render hang --steps 5 --size 64x48 --out '" + picture.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const std::string bytes = read(picture);
+  ASSERT_GT(bytes.size(), 24u);
+  EXPECT_EQ(bytes.substr(1, 3), "PNG");
+  // IHDR: width and height as big-endian 32-bit numbers at bytes 16 and 20.
+  const auto be32 = [&](std::size_t at) {
+    return (static_cast<unsigned char>(bytes[at]) << 24) | (static_cast<unsigned char>(bytes[at + 1]) << 16) |
+           (static_cast<unsigned char>(bytes[at + 2]) << 8) | static_cast<unsigned char>(bytes[at + 3]);
+  };
+  EXPECT_EQ(be32(16), 64);
+  EXPECT_EQ(be32(20), 48);
+}
+
+TEST_F(Cli, RenderEveryKStepsWritesAFrameSequence) {
+  const fs::path folder = file("frames");
+  const Result result = run("render chain --steps 10 --every 4 --size 32x32 --out-dir '" + folder.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  for (const char* name : {"frame-000000.png", "frame-000004.png", "frame-000008.png"}) {
+    EXPECT_TRUE(fs::exists(folder / name)) << name;
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(folder), fs::directory_iterator{}), 3);
+}
+
+TEST_F(Cli, RenderRefusesBadValuesWithOneLine) {
+  const std::string out = " --out '" + file("x.png").string() + "'";
+  expectOneLineError(run("render hang --size 100" + out), 2, "--size 100: expected WxH");
+  expectOneLineError(run("render hang --size 0x10" + out), 2, "--size 0x10: expected WxH");
+  expectOneLineError(run("render hang --camera sideways" + out), 2, "--camera sideways: expected auto, front");
+  expectOneLineError(run("render hang --camera 10,95,3" + out), 2, "--camera 10,95,3: expected");
+  expectOneLineError(run("render hang --out '" + file("x.jpg").string() + "'"), 2, "expected a file ending in .png");
+  expectOneLineError(run("render hang --out /nonexistent-dir/x.png"), 2, "/nonexistent-dir/x.png: cannot write");
+  expectOneLineError(run("render hang"), 2, "say where the pictures go");
+  EXPECT_FALSE(fs::exists(file("x.png")));
+}
+
+TEST_F(Cli, AStepCountPastTheLimitIsBadInput) {
+  expectOneLineError(run("run hang --set duration=100000 --set solver.dt=1e-6"), 2,
+                     "duration / solver.dt asks for 100000000000 steps, more than the limit of 1000000000");
+}
 
 TEST_F(Cli, MissingSceneFileIsBadInput) {
   expectOneLineError(run("run '" + file("nope.json").string() + "'"), 2, "nope.json: cannot open the scene file");

@@ -1,5 +1,7 @@
 #include "commands.hpp"
 
+#include "common.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -20,15 +22,6 @@ namespace drape::cli {
 
 namespace {
 
-int badInput(const std::string& message) {
-  std::cerr << "drape-cli: error: " << message << "\n";
-  return kExitBadInput;
-}
-
-scene::Scene load(const SceneArguments& arguments) {
-  return scene::loadScene(scene::resolveScenePath(arguments.scene), arguments.overrides);
-}
-
 std::size_t countConstraints(const sim::World& world) {
   std::size_t count = 0;
   for (const sim::Cloth& cloth : world.cloths()) {
@@ -43,15 +36,6 @@ std::size_t countParticles(const sim::World& world) {
   return count;
 }
 
-// The engine validates too; its messages are a last line of defence behind the scene reader's.
-sim::World makeWorld(const scene::Scene& scene) {
-  try {
-    return sim::World(scene.world);
-  } catch (const std::invalid_argument& error) {
-    throw scene::InputError(scene.source + ": " + error.what());
-  }
-}
-
 enum class OutputKind { state, mesh };
 
 OutputKind outputKind(const std::string& file) {
@@ -59,6 +43,22 @@ OutputKind outputKind(const std::string& file) {
   if (extension == ".json") return OutputKind::state;
   if (extension == ".obj") return OutputKind::mesh;
   throw scene::InputError("--out " + file + ": expected a file ending in .json (state) or .obj (mesh)");
+}
+
+void rejectBadOutputs(const RunArguments& arguments) {
+  std::vector<std::string> all = arguments.outputs;
+  if (arguments.traceOut) all.push_back(*arguments.traceOut);
+  std::vector<std::filesystem::path> seen;
+  for (const std::string& file : all) {
+    if (file != arguments.traceOut.value_or("")) outputKind(file);
+    std::error_code error;
+    const std::filesystem::path canonical =
+        std::filesystem::weakly_canonical(std::filesystem::absolute(file, error), error);
+    if (std::find(seen.begin(), seen.end(), canonical) != seen.end()) {
+      throw scene::InputError(file + ": named as an output twice");
+    }
+    seen.push_back(canonical);
+  }
 }
 
 struct TraceTarget {
@@ -99,7 +99,7 @@ void appendTraceRow(std::ostringstream& csv, const sim::World& world, const Trac
 
 int validate(const SceneArguments& arguments) {
   try {
-    const scene::Scene scene = load(arguments);
+    const scene::Scene scene = loadScene(arguments);
     const sim::World world = makeWorld(scene);
     std::cout << scene.source << ": ok: \"" << scene.name << "\", " << world.cloths().size() << " cloth(s), "
               << countParticles(world) << " particles, " << countConstraints(world) << " constraints, "
@@ -112,14 +112,10 @@ int validate(const SceneArguments& arguments) {
 
 int run(const RunArguments& arguments) {
   try {
-    const scene::Scene scene = load(arguments.input);
+    const scene::Scene scene = loadScene(arguments.input);
     sim::World world = makeWorld(scene);
-    for (const std::string& file : arguments.outputs) outputKind(file);  // reject before running
-    const double dt = scene.world.solver.dt;
-    const std::int64_t steps =
-        arguments.steps ? *arguments.steps
-                        : static_cast<std::int64_t>(
-                              std::ceil((arguments.seconds ? *arguments.seconds : scene.duration) / dt - 1e-9));
+    rejectBadOutputs(arguments);  // before running, not after
+    const std::int64_t steps = stepCount(scene, arguments.steps, arguments.seconds);
 
     std::optional<TraceTarget> target;
     std::ostringstream trace;
@@ -132,22 +128,18 @@ int run(const RunArguments& arguments) {
 
     const auto start = std::chrono::steady_clock::now();
     for (std::int64_t i = 0; i < steps; ++i) {
-      if (world.step() == sim::StepStatus::diverged) {
-        const sim::Divergence& d = *world.divergence();
-        std::cerr << "drape-cli: error: " << scene.source << ": diverged at step " << d.step
-                  << " (t = " << static_cast<double>(d.step) * dt << " s): cloth " << d.cloth << " particle "
-                  << d.particle << " became non-finite or ran away past " << sim::kRunawayDistance
-                  << " m; nothing written\n";
-        return kExitDiverged;
-      }
+      if (world.step() == sim::StepStatus::diverged) return reportDivergence(scene, world);
       if (target) appendTraceRow(trace, world, *target);
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     std::vector<scene::OutputFile> files;
     for (const std::string& file : arguments.outputs) {
-      files.push_back({file, outputKind(file) == OutputKind::state ? scene::stateDocument(scene, world).dump(1) + "\n"
-                                                                   : scene::objText(world)});
+      files.push_back(
+          {file,
+           outputKind(file) == OutputKind::state
+               ? scene::stateDocument(scene, world).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
+               : scene::objText(world)});
     }
     if (arguments.traceOut) files.push_back({*arguments.traceOut, trace.str()});
     scene::writeFilesAtomically(files);

@@ -14,6 +14,7 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitDiverged = 1;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitInternal = 3;
+inline constexpr double kMaxSteps = 1.0e9;  // per run
 
 struct SceneArguments {
   std::string scene;                   // path, or the name of a shipped scene
@@ -31,7 +32,21 @@ struct RunArguments {
   bool quiet = false;
 };
 
+struct RenderArguments {
+  SceneArguments input;
+  std::optional<std::int64_t> steps;
+  std::optional<double> seconds;
+  std::string size = "800x600";       // WxH pixels
+  std::string camera = "auto";        // a preset or yaw,pitch,distance[,x,y,z]
+  std::optional<std::string> out;     // one picture of the last step
+  std::optional<std::int64_t> every;  // a picture every K steps ...
+  std::optional<std::string> outDir;  // ... into this folder
+  bool strain = false;                // strain colour map
+  bool quiet = false;
+};
+
 int validate(const SceneArguments& arguments);
+int render(const RenderArguments& arguments);
 int run(const RunArguments& arguments);
 int listScenes();
 

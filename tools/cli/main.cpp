@@ -37,6 +37,31 @@ int main(int argc, char** argv) {
   traceOut->needs(trace);
   runCommand->add_flag("--quiet", runArguments.quiet, "Print nothing on success");
 
+  RenderArguments renderArguments;
+  CLI::App* renderCommand =
+      app.add_subcommand("render", "Simulate a scene and draw it off-screen (OSMesa) to PNG pictures");
+  renderCommand->add_option("scene", renderArguments.input.scene, "Scene file, or the name of a shipped scene")
+      ->required();
+  renderCommand->add_option("--set", renderArguments.input.overrides, "Override a key: path=value (repeatable)");
+  CLI::Option* renderSteps =
+      renderCommand->add_option("--steps", renderArguments.steps, "Steps to simulate (default: the scene's duration)")
+          ->check(CLI::Range(std::int64_t{0}, std::int64_t{1000000000}));
+  renderCommand->add_option("--time", renderArguments.seconds, "Simulated seconds instead of --steps")
+      ->check(CLI::Range(0.0, 1.0e6))
+      ->excludes(renderSteps);
+  renderCommand->add_option("--size", renderArguments.size, "Picture size WxH in pixels (default 800x600)");
+  renderCommand->add_option("--camera", renderArguments.camera,
+                            "auto, front, side, top, or yaw,pitch,distance[,x,y,z] in degrees and metres");
+  CLI::Option* renderOut = renderCommand->add_option("--out", renderArguments.out, "PNG of the last step");
+  CLI::Option* every = renderCommand->add_option("--every", renderArguments.every, "A PNG every K steps (and step 0)")
+                           ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000000}));
+  CLI::Option* outDir = renderCommand->add_option("--out-dir", renderArguments.outDir, "Folder for the --every frames");
+  every->needs(outDir);
+  outDir->needs(every);
+  renderOut->excludes(every);
+  renderCommand->add_flag("--strain", renderArguments.strain, "Colour the cloth by its stretch");
+  renderCommand->add_flag("--quiet", renderArguments.quiet, "Print nothing on success");
+
   app.add_subcommand("scenes", "List the shipped scenes");
 
   try {
@@ -49,6 +74,7 @@ int main(int argc, char** argv) {
   try {
     if (*validateCommand) return validate(validateArguments);
     if (*runCommand) return run(runArguments);
+    if (*renderCommand) return render(renderArguments);
     return listScenes();
   } catch (const std::exception& error) {  // a bug, not bad input: say so rather than abort
     std::cerr << "drape-cli: internal error: " << error.what() << "\n";

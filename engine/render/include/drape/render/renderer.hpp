@@ -1,0 +1,85 @@
+// The OpenGL 3.3 core renderer. It knows nothing of SDL or OSMesa: whoever made the context hands
+// it a get-proc-address function, and the same code draws in a window and off-screen.
+//
+// What it draws: each cloth as a smooth two-sided lit surface (normals recomputed every frame, a
+// front and a back colour, optionally a strain colour map); a chain as links and beads; the table
+// (y = 0) with a soft shadow of the cloth; pins as round markers; and an overlay of finger rings
+// and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry.
+// Positions and normals stream every frame into buffers allocated once; index buffers are
+// re-uploaded only when the world's topology version changes.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "drape/render/camera.hpp"
+#include "drape/sim/world.hpp"
+
+namespace drape::render {
+
+class RenderError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+using GetProcAddress = void* (*)(const char* name);
+
+struct OverlayVertex {
+  glm::vec3 position;
+  glm::vec4 colour;
+};
+
+// Markers drawn over the scene, unlit and always visible.
+struct Overlay {
+  std::vector<OverlayVertex> points;  // round markers
+  std::vector<OverlayVertex> lines;   // pairs of vertices
+
+  // A ring of `radius` around `centre` in the plane with normal `normal` (a finger).
+  void addRing(glm::dvec3 centre, double radius, glm::dvec3 normal, glm::vec4 colour, int segments = 48);
+  // A polyline through `points` (an outline being drawn).
+  void addStroke(const std::vector<glm::dvec3>& points, glm::vec4 colour);
+};
+
+struct FrameOptions {
+  bool strainMap = false;     // colour by stretch instead of the front/back colours
+  float strainScale = 0.10f;  // strain shown fully red
+  bool showPins = true;
+  glm::vec3 frontColour{0.85f, 0.33f, 0.18f};
+  glm::vec3 backColour{0.20f, 0.52f, 0.62f};
+  glm::vec3 backgroundColour{0.62f, 0.66f, 0.70f};
+};
+
+class Renderer {
+ public:
+  // Needs a current context of at least GL 3.3 core. Throws RenderError if GL cannot be loaded or
+  // a shader does not compile.
+  explicit Renderer(GetProcAddress getProcAddress);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Draws one frame into the framebuffer bound now, over a viewport of width x height pixels.
+  void render(const sim::World& world, const Camera& camera, int width, int height, const FrameOptions& options,
+              const Overlay& overlay = {});
+
+  // RGBA8 pixels of the bound read framebuffer, top row first.
+  std::vector<std::uint8_t> readPixels(int width, int height) const;
+
+  std::string description() const;  // "4.5 (Core Profile) Mesa ..., llvmpipe ..."
+  int uploadsOfTopology() const;    // how often index buffers were (re)built: for tests
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The box around every particle of the world (and the table at y = 0 under it).
+void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper);
+
+}  // namespace drape::render

@@ -1,0 +1,502 @@
+#include "drape/render/renderer.hpp"
+
+// The loader comes first: it provides the GL declarations for everything below.
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string_view>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "drape/sim/metrics.hpp"
+
+namespace drape::render {
+
+namespace shaders {
+extern const std::string_view cloth_vert, cloth_frag, ground_frag, shadow_vert, shadow_frag, overlay_vert, overlay_frag;
+}
+
+namespace {
+
+constexpr int kShadowMapSize = 2048;
+const glm::dvec3 kTowardsLight = glm::normalize(glm::dvec3{0.35, 1.0, 0.25});
+
+GLuint compile(GLenum kind, std::string_view source, const char* name) {
+  const GLuint shader = glCreateShader(kind);
+  const char* text = source.data();
+  const GLint length = static_cast<GLint>(source.size());
+  glShaderSource(shader, 1, &text, &length);
+  glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+    glDeleteShader(shader);
+    std::string message = std::string("shader ") + name + " does not compile: " + log;
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    throw RenderError(message);
+  }
+  return shader;
+}
+
+GLuint link(std::string_view vertex, std::string_view fragment, const char* name) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex, name);
+  const GLuint fs = compile(GL_FRAGMENT_SHADER, fragment, name);
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = GL_FALSE;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetProgramInfoLog(program, sizeof log, nullptr, log);
+    throw RenderError(std::string("program ") + name + " does not link: " + log);
+  }
+  return program;
+}
+
+GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+
+void setMatrix(GLuint program, const char* name, const glm::mat4& m) {
+  glUniformMatrix4fv(uniform(program, name), 1, GL_FALSE, glm::value_ptr(m));
+}
+void setVec3(GLuint program, const char* name, glm::vec3 v) {
+  glUniform3fv(uniform(program, name), 1, glm::value_ptr(v));
+}
+
+// One cloth on the GPU: streamed positions, normals and strains, and its (topology) indices.
+struct GpuCloth {
+  GLuint vao = 0, positions = 0, normals = 0, strains = 0, indices = 0;
+  GLsizei triangleIndexCount = 0;
+  GLuint lineVao = 0, lineIndices = 0;  // chains: links drawn as lines with the overlay program
+  GLsizei lineIndexCount = 0;
+  std::size_t particles = 0;
+};
+
+}  // namespace
+
+void Overlay::addRing(glm::dvec3 centre, double radius, glm::dvec3 normal, glm::vec4 colour, int segments) {
+  const glm::dvec3 n = glm::length(normal) > 0.0 ? glm::normalize(normal) : glm::dvec3{0.0, 1.0, 0.0};
+  const glm::dvec3 helper = std::abs(n.y) < 0.9 ? glm::dvec3{0.0, 1.0, 0.0} : glm::dvec3{1.0, 0.0, 0.0};
+  const glm::dvec3 u = glm::normalize(glm::cross(n, helper)), v = glm::cross(n, u);
+  for (int i = 0; i < segments; ++i) {
+    for (int end = 0; end < 2; ++end) {
+      const double angle = 2.0 * 3.14159265358979 * (i + end) / segments;
+      lines.push_back({glm::vec3(centre + (u * std::cos(angle) + v * std::sin(angle)) * radius), colour});
+    }
+  }
+}
+
+void Overlay::addStroke(const std::vector<glm::dvec3>& stroke, glm::vec4 colour) {
+  for (std::size_t i = 1; i < stroke.size(); ++i) {
+    lines.push_back({glm::vec3(stroke[i - 1]), colour});
+    lines.push_back({glm::vec3(stroke[i]), colour});
+  }
+}
+
+void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
+  lower = glm::dvec3{std::numeric_limits<double>::max()};
+  upper = glm::dvec3{std::numeric_limits<double>::lowest()};
+  for (const sim::Cloth& cloth : world.cloths()) {
+    for (const sim::Vec3& x : cloth.state.position) {
+      lower = glm::min(lower, x);
+      upper = glm::max(upper, x);
+    }
+  }
+  if (lower.x > upper.x) {  // nothing in the world: frame the table around the origin
+    lower = glm::dvec3{-1.0, 0.0, -1.0};
+    upper = glm::dvec3{1.0, 1.0, 1.0};
+  }
+  lower.y = std::min(lower.y, 0.0);
+}
+
+struct Renderer::Impl {
+  GLuint clothProgram = 0, groundProgram = 0, shadowProgram = 0, overlayProgram = 0;
+  GLuint shadowFramebuffer = 0, shadowTexture = 0;
+  GLuint sampleFramebuffer = 0, sampleColour = 0, sampleDepth = 0;
+  int sampleWidth = 0, sampleHeight = 0, samples = 0;
+  GLuint groundVao = 0, groundBuffer = 0;
+  GLuint overlayVao = 0, overlayBuffer = 0;
+  std::size_t overlayCapacity = 0;
+  std::vector<GpuCloth> cloths;
+  std::uint64_t topologyVersion = 0;
+  int topologyUploads = 0;
+  // Staging arrays reused every frame (single precision for the GPU).
+  std::vector<glm::vec3> positions, normals;
+  std::vector<float> strains;
+  std::vector<sim::Vec3> normalScratch;
+  std::vector<OverlayVertex> overlayScratch;
+
+  void releaseCloths() {
+    for (GpuCloth& c : cloths) {
+      glDeleteVertexArrays(1, &c.vao);
+      glDeleteVertexArrays(1, &c.lineVao);
+      const GLuint buffers[] = {c.positions, c.normals, c.strains, c.indices, c.lineIndices};
+      glDeleteBuffers(5, buffers);
+    }
+    cloths.clear();
+  }
+
+  void uploadTopology(const sim::World& world) {
+    releaseCloths();
+    for (const sim::Cloth& cloth : world.cloths()) {
+      GpuCloth gpu;
+      gpu.particles = cloth.state.position.size();
+      const auto bytes3 = static_cast<GLsizeiptr>(gpu.particles * sizeof(glm::vec3));
+      glGenVertexArrays(1, &gpu.vao);
+      glBindVertexArray(gpu.vao);
+      const auto attribute = [](GLuint& buffer, GLuint location, GLint size, GLsizeiptr bytes) {
+        glGenBuffers(1, &buffer);
+        glBindBuffer(GL_ARRAY_BUFFER, buffer);
+        glBufferData(GL_ARRAY_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
+        glVertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, 0, nullptr);
+        glEnableVertexAttribArray(location);
+      };
+      attribute(gpu.positions, 0, 3, bytes3);
+      attribute(gpu.normals, 1, 3, bytes3);
+      attribute(gpu.strains, 2, 1, static_cast<GLsizeiptr>(gpu.particles * sizeof(float)));
+      glGenBuffers(1, &gpu.indices);
+      glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.indices);
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(cloth.rest.triangles.size() * sizeof(glm::uvec3)),
+                   cloth.rest.triangles.data(), GL_STATIC_DRAW);
+      gpu.triangleIndexCount = static_cast<GLsizei>(cloth.rest.triangles.size() * 3);
+      if (cloth.rest.triangles.empty()) {
+        // A chain: its stretch links as lines, positions from the same buffer, no normals.
+        std::vector<std::uint32_t> links;
+        for (const sim::DistanceConstraint& c : cloth.rest.of(sim::ConstraintKind::stretch)) {
+          links.push_back(c.a);
+          links.push_back(c.b);
+        }
+        glGenVertexArrays(1, &gpu.lineVao);
+        glBindVertexArray(gpu.lineVao);
+        glBindBuffer(GL_ARRAY_BUFFER, gpu.positions);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+        glEnableVertexAttribArray(0);
+        glVertexAttrib4f(1, 0.15f, 0.15f, 0.18f, 1.0f);
+        glGenBuffers(1, &gpu.lineIndices);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.lineIndices);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(links.size() * sizeof(std::uint32_t)),
+                     links.data(), GL_STATIC_DRAW);
+        gpu.lineIndexCount = static_cast<GLsizei>(links.size());
+      }
+      cloths.push_back(gpu);
+    }
+    glBindVertexArray(0);
+    topologyVersion = world.topologyVersion();
+    ++topologyUploads;
+  }
+
+  void streamCloth(const sim::Cloth& cloth, const GpuCloth& gpu, bool strainMap) {
+    const std::size_t n = cloth.state.position.size();
+    positions.resize(n);
+    for (std::size_t i = 0; i < n; ++i) positions[i] = glm::vec3(cloth.state.position[i]);
+    normalScratch = sim::vertexNormals(cloth);
+    normals.resize(n);
+    for (std::size_t i = 0; i < n; ++i) normals[i] = glm::vec3(normalScratch[i]);
+    strains.assign(n, 0.0f);
+    if (strainMap) {
+      // A particle shows the largest stretch among its structural links.
+      for (const sim::DistanceConstraint& c : cloth.rest.of(sim::ConstraintKind::stretch)) {
+        if (!(c.restLength > 0.0)) continue;
+        const auto e =
+            static_cast<float>(glm::length(cloth.state.position[c.b] - cloth.state.position[c.a]) / c.restLength - 1.0);
+        strains[c.a] = std::max(strains[c.a], e);
+        strains[c.b] = std::max(strains[c.b], e);
+      }
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, gpu.positions);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(n * sizeof(glm::vec3)), positions.data());
+    glBindBuffer(GL_ARRAY_BUFFER, gpu.normals);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(n * sizeof(glm::vec3)), normals.data());
+    glBindBuffer(GL_ARRAY_BUFFER, gpu.strains);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(n * sizeof(float)), strains.data());
+  }
+
+  void ensureSampleTarget(int width, int height) {
+    if (samples == 0 || (width == sampleWidth && height == sampleHeight)) return;
+    if (!sampleFramebuffer) {
+      glGenFramebuffers(1, &sampleFramebuffer);
+      glGenRenderbuffers(1, &sampleColour);
+      glGenRenderbuffers(1, &sampleDepth);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, sampleColour);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, sampleDepth);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, sampleFramebuffer);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, sampleColour);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, sampleDepth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) samples = 0;  // draw without MSAA
+    sampleWidth = width;
+    sampleHeight = height;
+  }
+
+  void drawOverlay(const std::vector<OverlayVertex>& vertices, GLenum mode) {
+    if (vertices.empty()) return;
+    glBindVertexArray(overlayVao);
+    glBindBuffer(GL_ARRAY_BUFFER, overlayBuffer);
+    if (vertices.size() > overlayCapacity) {
+      overlayCapacity = std::max(vertices.size(), overlayCapacity * 2);
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(overlayCapacity * sizeof(OverlayVertex)), nullptr,
+                   GL_STREAM_DRAW);
+    }
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(vertices.size() * sizeof(OverlayVertex)),
+                    vertices.data());
+    glDrawArrays(mode, 0, static_cast<GLsizei>(vertices.size()));
+  }
+};
+
+Renderer::Renderer(GetProcAddress getProcAddress) : impl_(std::make_unique<Impl>()) {
+  const int version = gladLoadGL(reinterpret_cast<GLADloadfunc>(getProcAddress));
+  if (version == 0) throw RenderError("cannot load OpenGL functions");
+  if (GLAD_VERSION_MAJOR(version) * 10 + GLAD_VERSION_MINOR(version) < 33) {
+    throw RenderError("OpenGL 3.3 core is needed, the context has " + std::to_string(GLAD_VERSION_MAJOR(version)) +
+                      "." + std::to_string(GLAD_VERSION_MINOR(version)));
+  }
+  Impl& r = *impl_;
+  r.clothProgram = link(shaders::cloth_vert, shaders::cloth_frag, "cloth");
+  r.groundProgram = link(shaders::cloth_vert, shaders::ground_frag, "ground");
+  r.shadowProgram = link(shaders::shadow_vert, shaders::shadow_frag, "shadow");
+  r.overlayProgram = link(shaders::overlay_vert, shaders::overlay_frag, "overlay");
+
+  // Shadow map: a depth texture compared in hardware, filtered linearly (then PCF in the shader).
+  glGenTextures(1, &r.shadowTexture);
+  glBindTexture(GL_TEXTURE_2D, r.shadowTexture);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, kShadowMapSize, kShadowMapSize, 0, GL_DEPTH_COMPONENT,
+               GL_UNSIGNED_INT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  glGenFramebuffers(1, &r.shadowFramebuffer);
+  glBindFramebuffer(GL_FRAMEBUFFER, r.shadowFramebuffer);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, r.shadowTexture, 0);
+  glDrawBuffer(GL_NONE);
+  glReadBuffer(GL_NONE);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw RenderError("the shadow-map framebuffer is incomplete");
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+  GLint maxSamples = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &maxSamples);
+  r.samples = std::min(4, static_cast<int>(maxSamples));
+
+  // The table: one quad, strain attribute constant 0, normal +y.
+  glGenVertexArrays(1, &r.groundVao);
+  glBindVertexArray(r.groundVao);
+  glGenBuffers(1, &r.groundBuffer);
+  glBindBuffer(GL_ARRAY_BUFFER, r.groundBuffer);
+  glBufferData(GL_ARRAY_BUFFER, 4 * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glEnableVertexAttribArray(0);
+  glVertexAttrib3f(1, 0.0f, 1.0f, 0.0f);
+  glVertexAttrib1f(2, 0.0f);
+
+  glGenVertexArrays(1, &r.overlayVao);
+  glBindVertexArray(r.overlayVao);
+  glGenBuffers(1, &r.overlayBuffer);
+  glBindBuffer(GL_ARRAY_BUFFER, r.overlayBuffer);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(OverlayVertex), nullptr);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, sizeof(OverlayVertex),
+                        reinterpret_cast<const void*>(offsetof(OverlayVertex, colour)));
+  glEnableVertexAttribArray(1);
+  glBindVertexArray(0);
+  if (glGetError() != GL_NO_ERROR) throw RenderError("OpenGL reported an error while setting up the renderer");
+}
+
+Renderer::~Renderer() {
+  Impl& r = *impl_;
+  r.releaseCloths();
+  for (GLuint program : {r.clothProgram, r.groundProgram, r.shadowProgram, r.overlayProgram}) glDeleteProgram(program);
+  glDeleteFramebuffers(1, &r.shadowFramebuffer);
+  glDeleteTextures(1, &r.shadowTexture);
+  glDeleteFramebuffers(1, &r.sampleFramebuffer);
+  glDeleteRenderbuffers(1, &r.sampleColour);
+  glDeleteRenderbuffers(1, &r.sampleDepth);
+  glDeleteVertexArrays(1, &r.groundVao);
+  glDeleteBuffers(1, &r.groundBuffer);
+  glDeleteVertexArrays(1, &r.overlayVao);
+  glDeleteBuffers(1, &r.overlayBuffer);
+}
+
+void Renderer::render(const sim::World& world, const Camera& camera, int width, int height, const FrameOptions& options,
+                      const Overlay& overlay) {
+  Impl& r = *impl_;
+  if (width <= 0 || height <= 0) return;  // a minimised window: nothing to draw
+  GLint target = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
+
+  if (world.topologyVersion() != r.topologyVersion || r.cloths.size() != world.cloths().size()) {
+    r.uploadTopology(world);
+  }
+  for (std::size_t c = 0; c < world.cloths().size(); ++c)
+    r.streamCloth(world.cloths()[c], r.cloths[c], options.strainMap);
+
+  // The light looks at the scene from kTowardsLight with an orthographic box around it.
+  glm::dvec3 lower, upper;
+  sceneBounds(world, lower, upper);
+  const glm::dvec3 centre = (lower + upper) * 0.5;
+  const double radius = std::max(0.5, glm::length(upper - lower) * 0.5) * 1.1;
+  const glm::mat4 lightView =
+      glm::mat4(glm::lookAt(centre + kTowardsLight * (radius * 2.0), centre, glm::dvec3{0.0, 0.0, -1.0}));
+  const glm::mat4 lightProjection =
+      glm::ortho<float>(static_cast<float>(-radius), static_cast<float>(radius), static_cast<float>(-radius),
+                        static_cast<float>(radius), 0.0f, static_cast<float>(radius * 4.0));
+  const glm::mat4 lightViewProjection = lightProjection * lightView;
+
+  glEnable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);  // cloth is two-sided
+  glDisable(GL_BLEND);
+
+  // Shadow pass.
+  glBindFramebuffer(GL_FRAMEBUFFER, r.shadowFramebuffer);
+  glViewport(0, 0, kShadowMapSize, kShadowMapSize);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glUseProgram(r.shadowProgram);
+  setMatrix(r.shadowProgram, "lightViewProjection", lightViewProjection);
+  for (const GpuCloth& gpu : r.cloths) {
+    if (gpu.triangleIndexCount == 0) continue;
+    glBindVertexArray(gpu.vao);
+    glDrawElements(GL_TRIANGLES, gpu.triangleIndexCount, GL_UNSIGNED_INT, nullptr);
+  }
+
+  // Main pass, multisampled when the context can.
+  const double aspect = static_cast<double>(width) / height;
+  const glm::mat4 viewProjection = camera.projection(aspect) * camera.view();
+  r.ensureSampleTarget(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, r.samples > 0 ? r.sampleFramebuffer : static_cast<GLuint>(target));
+  glViewport(0, 0, width, height);
+  glClearColor(options.backgroundColour.r, options.backgroundColour.g, options.backgroundColour.b, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, r.shadowTexture);
+
+  const glm::vec3 eye(camera.eye());
+  const glm::vec3 towardsLight(kTowardsLight);
+  const float extent = static_cast<float>(std::max(20.0, camera.distance * 10.0));
+  const glm::vec3 middle(static_cast<float>(camera.target.x), 0.0f, static_cast<float>(camera.target.z));
+  const glm::vec3 quad[4] = {middle + glm::vec3{-extent, 0, -extent}, middle + glm::vec3{extent, 0, -extent},
+                             middle + glm::vec3{-extent, 0, extent}, middle + glm::vec3{extent, 0, extent}};
+  glUseProgram(r.groundProgram);
+  setMatrix(r.groundProgram, "viewProjection", viewProjection);
+  setMatrix(r.groundProgram, "lightViewProjection", lightViewProjection);
+  setVec3(r.groundProgram, "lightDirection", towardsLight);
+  setVec3(r.groundProgram, "eyePosition", eye);
+  setVec3(r.groundProgram, "backgroundColour", options.backgroundColour);
+  glUniform1i(uniform(r.groundProgram, "shadowMap"), 0);
+  glBindVertexArray(r.groundVao);
+  glBindBuffer(GL_ARRAY_BUFFER, r.groundBuffer);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, sizeof quad, quad);
+  // The table sits a hair below y = 0 so cloth lying on it is never hidden by it.
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.0f, 1.0f);
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+
+  glUseProgram(r.clothProgram);
+  setMatrix(r.clothProgram, "viewProjection", viewProjection);
+  setMatrix(r.clothProgram, "lightViewProjection", lightViewProjection);
+  setVec3(r.clothProgram, "lightDirection", towardsLight);
+  setVec3(r.clothProgram, "eyePosition", eye);
+  setVec3(r.clothProgram, "frontColour", options.frontColour);
+  setVec3(r.clothProgram, "backColour", options.backColour);
+  glUniform1i(uniform(r.clothProgram, "strainMap"), options.strainMap ? 1 : 0);
+  glUniform1f(uniform(r.clothProgram, "strainScale"), std::max(1e-6f, options.strainScale));
+  glUniform1i(uniform(r.clothProgram, "shadowMap"), 0);
+  for (const GpuCloth& gpu : r.cloths) {
+    if (gpu.triangleIndexCount == 0) continue;
+    glBindVertexArray(gpu.vao);
+    glDrawElements(GL_TRIANGLES, gpu.triangleIndexCount, GL_UNSIGNED_INT, nullptr);
+  }
+
+  // Chains, pins and the overlay.
+  glUseProgram(r.overlayProgram);
+  setMatrix(r.overlayProgram, "viewProjection", viewProjection);
+  glEnable(GL_PROGRAM_POINT_SIZE);
+  glUniform1i(uniform(r.overlayProgram, "roundPoints"), 0);
+  for (const GpuCloth& gpu : r.cloths) {
+    if (gpu.lineIndexCount == 0) continue;
+    glBindVertexArray(gpu.lineVao);
+    glDrawElements(GL_LINES, gpu.lineIndexCount, GL_UNSIGNED_INT, nullptr);
+  }
+  const float pixelsPerMetre =
+      static_cast<float>(height / (2.0 * std::tan(camera.fieldOfView / 2.0) * camera.distance));
+  r.overlayScratch.clear();
+  for (const sim::Cloth& cloth : world.cloths()) {
+    if (!cloth.rest.triangles.empty()) continue;  // beads of a chain
+    for (const sim::Vec3& x : cloth.state.position)
+      r.overlayScratch.push_back({glm::vec3(x), glm::vec4(options.frontColour, 1.0f)});
+  }
+  glUniform1i(uniform(r.overlayProgram, "roundPoints"), 1);
+  glUniform1f(uniform(r.overlayProgram, "pointSize"), std::clamp(pixelsPerMetre * 0.03f, 4.0f, 24.0f));
+  r.drawOverlay(r.overlayScratch, GL_POINTS);
+
+  glDisable(GL_DEPTH_TEST);  // markers stay visible through the cloth
+  glUniform1i(uniform(r.overlayProgram, "roundPoints"), 0);
+  r.drawOverlay(overlay.lines, GL_LINES);
+  r.overlayScratch.clear();
+  if (options.showPins) {
+    for (const sim::Cloth& cloth : world.cloths()) {
+      for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+        if (cloth.state.inverseMass[i] == 0.0) {
+          r.overlayScratch.push_back({glm::vec3(cloth.state.position[i]), glm::vec4(0.95f, 0.85f, 0.25f, 1.0f)});
+        }
+      }
+    }
+  }
+  r.overlayScratch.insert(r.overlayScratch.end(), overlay.points.begin(), overlay.points.end());
+  glUniform1i(uniform(r.overlayProgram, "roundPoints"), 1);
+  glUniform1f(uniform(r.overlayProgram, "pointSize"), 11.0f);
+  r.drawOverlay(r.overlayScratch, GL_POINTS);
+  glEnable(GL_DEPTH_TEST);
+
+  if (r.samples > 0) {  // resolve into the caller's framebuffer
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r.sampleFramebuffer);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target));
+  glBindVertexArray(0);
+}
+
+std::vector<std::uint8_t> Renderer::readPixels(int width, int height) const {
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(width) * height * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels.data());
+  // GL's rows run bottom-up; images are written top-down.
+  const std::size_t stride = static_cast<std::size_t>(width) * 4;
+  std::vector<std::uint8_t> row(stride);
+  for (int y = 0; y < height / 2; ++y) {
+    std::uint8_t* a = pixels.data() + static_cast<std::size_t>(y) * stride;
+    std::uint8_t* b = pixels.data() + static_cast<std::size_t>(height - 1 - y) * stride;
+    std::memcpy(row.data(), a, stride);
+    std::memcpy(a, b, stride);
+    std::memcpy(b, row.data(), stride);
+  }
+  return pixels;
+}
+
+std::string Renderer::description() const {
+  const auto text = [](GLenum name) {
+    const auto* value = reinterpret_cast<const char*>(glGetString(name));
+    return std::string(value ? value : "?");
+  };
+  return text(GL_VERSION) + ", " + text(GL_RENDERER);
+}
+
+int Renderer::uploadsOfTopology() const { return impl_->topologyUploads; }
+
+}  // namespace drape::render

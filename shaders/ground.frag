@@ -1,0 +1,34 @@
+#version 330 core
+// The table: a light neutral floor with a faint 10 cm grid, fading into the background with
+// distance, darkened where the cloth's shadow falls.
+in vec3 worldPosition;
+in vec3 worldNormal;
+in vec4 lightSpacePosition;
+in float vertexStrain;
+
+uniform vec3 lightDirection;
+uniform vec3 eyePosition;
+uniform vec3 backgroundColour;
+uniform sampler2DShadow shadowMap;
+
+out vec4 fragmentColour;
+
+float shadowFactor() {
+  vec3 p = lightSpacePosition.xyz / lightSpacePosition.w * 0.5 + 0.5;
+  if (p.x < 0.0 || p.x > 1.0 || p.y < 0.0 || p.y > 1.0 || p.z > 1.0) return 1.0;
+  vec2 texel = 1.0 / vec2(textureSize(shadowMap, 0));
+  float lit = 0.0;
+  for (int x = -3; x <= 3; ++x)
+    for (int y = -3; y <= 3; ++y) lit += texture(shadowMap, vec3(p.xy + vec2(x, y) * texel * 2.0, p.z - 0.002));
+  return lit / 49.0;
+}
+
+void main() {
+  vec2 cell = abs(fract(worldPosition.xz * 10.0 - 0.5) - 0.5) / fwidth(worldPosition.xz * 10.0);
+  // Grid lines fade out where they get denser than the pixels (no moire far away).
+  float line = (1.0 - min(min(cell.x, cell.y), 1.0)) * clamp(1.5 - length(fwidth(worldPosition.xz * 10.0)), 0.0, 1.0);
+  vec3 floorColour = vec3(0.78, 0.78, 0.76) - line * 0.06;
+  float light = 0.55 + 0.45 * shadowFactor();
+  float fade = clamp(length(worldPosition - eyePosition) / 25.0, 0.0, 1.0);
+  fragmentColour = vec4(mix(floorColour * light, backgroundColour, fade), 1.0);
+}

@@ -1,0 +1,49 @@
+#include "common.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "drape/scene/error.hpp"
+
+namespace drape::cli {
+
+int badInput(const std::string& message) {
+  std::cerr << "drape-cli: error: " << message << "\n";
+  return kExitBadInput;
+}
+
+scene::Scene loadScene(const SceneArguments& arguments) {
+  return scene::loadScene(scene::resolveScenePath(arguments.scene), arguments.overrides);
+}
+
+sim::World makeWorld(const scene::Scene& scene) {
+  try {
+    return sim::World(scene.world);
+  } catch (const std::invalid_argument& error) {
+    throw scene::InputError(scene.source + ": " + error.what());
+  }
+}
+
+std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> steps, std::optional<double> seconds) {
+  const double wanted = steps ? static_cast<double>(*steps)
+                              : std::ceil((seconds ? *seconds : scene.duration) / scene.world.solver.dt - 1e-9);
+  if (!(wanted <= kMaxSteps)) {
+    char count[64];
+    std::snprintf(count, sizeof count, "%.0f", wanted);
+    throw scene::InputError(scene.source + ": " + (seconds ? "--time" : "duration") + " / solver.dt asks for " + count +
+                            " steps, more than the limit of " + std::to_string(static_cast<long long>(kMaxSteps)));
+  }
+  return static_cast<std::int64_t>(wanted);
+}
+
+int reportDivergence(const scene::Scene& scene, const sim::World& world) {
+  const sim::Divergence& d = *world.divergence();
+  std::cerr << "drape-cli: error: " << scene.source << ": diverged at step " << d.step
+            << " (t = " << static_cast<double>(d.step) * scene.world.solver.dt << " s): cloth " << d.cloth
+            << " particle " << d.particle << " became non-finite or ran away (past " << sim::kRunawayDistance
+            << " m or " << sim::kRunawaySpeed << " m/s); nothing written\n";
+  return kExitDiverged;
+}
+
+}  // namespace drape::cli
