@@ -13,6 +13,7 @@ uniform vec3 backColour;
 uniform vec3 lightDirection;  // unit, from the surface towards the light
 uniform vec3 eyePosition;
 uniform bool strainMap;
+uniform bool twoSided;  // cloth: the back gets its own colour; colliders: one-sided solids
 uniform float strainScale;
 uniform sampler2DShadow shadowMap;
 
@@ -40,7 +41,7 @@ vec3 strainColour(float s) {
 void main() {
   vec3 n = normalize(worldNormal);
   vec3 base = frontColour;
-  if (!gl_FrontFacing) {
+  if (twoSided && !gl_FrontFacing) {
     n = -n;
     base = backColour;
   }

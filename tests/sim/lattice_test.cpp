@@ -19,12 +19,16 @@ TEST(Lattice, ConstraintCountsFollowTheSeedsLattice) {
 TEST(Lattice, RestLengthsAreTheSpacing) {
   // 5 columns over 1 m: 0.25 m along x; 4 rows over 0.6 m: 0.2 m along z.
   const ClothRest rest = buildLattice({5, 4, 1.0, 0.6, Vec3{0.0}, LatticePlane::xz});
-  const auto alongX = [&](const DistanceConstraint& c) { return rest.restPositions[c.a].z == rest.restPositions[c.b].z; };
+  const auto alongX = [&](const DistanceConstraint& c) {
+    return rest.restPositions[c.a].z == rest.restPositions[c.b].z;
+  };
   for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) {
     EXPECT_NEAR(c.restLength, alongX(c) ? 0.25 : 0.2, 1e-12);
   }
-  for (const DistanceConstraint& c : rest.of(ConstraintKind::shear)) EXPECT_NEAR(c.restLength, std::hypot(0.25, 0.2), 1e-12);
-  for (const DistanceConstraint& c : rest.of(ConstraintKind::bend)) EXPECT_NEAR(c.restLength, alongX(c) ? 0.5 : 0.4, 1e-12);
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::shear))
+    EXPECT_NEAR(c.restLength, std::hypot(0.25, 0.2), 1e-12);
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::bend))
+    EXPECT_NEAR(c.restLength, alongX(c) ? 0.5 : 0.4, 1e-12);
 }
 
 TEST(Lattice, IndexIsRowMajorAndPlanesPointTheRightWay) {

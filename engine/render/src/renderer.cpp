@@ -13,6 +13,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "collider_geometry.hpp"
 #include "drape/sim/metrics.hpp"
 
 namespace drape::render {
@@ -126,6 +127,8 @@ struct Renderer::Impl {
   int sampleWidth = 0, sampleHeight = 0, samples = 0;
   GLuint groundVao = 0, groundBuffer = 0;
   GLuint overlayVao = 0, overlayBuffer = 0;
+  GLuint colliderVao = 0, colliderPositions = 0, colliderNormals = 0, colliderIndices = 0;
+  ColliderGeometry colliderGeometry;
   std::size_t overlayCapacity = 0;
   std::vector<GpuCloth> cloths;
   std::uint64_t topologyVersion = 0;
@@ -304,6 +307,20 @@ Renderer::Renderer(GetProcAddress getProcAddress) : impl_(std::make_unique<Impl>
   glVertexAttrib3f(1, 0.0f, 1.0f, 0.0f);
   glVertexAttrib1f(2, 0.0f);
 
+  glGenVertexArrays(1, &r.colliderVao);
+  glBindVertexArray(r.colliderVao);
+  glGenBuffers(1, &r.colliderPositions);
+  glBindBuffer(GL_ARRAY_BUFFER, r.colliderPositions);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glEnableVertexAttribArray(0);
+  glGenBuffers(1, &r.colliderNormals);
+  glBindBuffer(GL_ARRAY_BUFFER, r.colliderNormals);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttrib1f(2, 0.0f);
+  glGenBuffers(1, &r.colliderIndices);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, r.colliderIndices);
+
   glGenVertexArrays(1, &r.overlayVao);
   glBindVertexArray(r.overlayVao);
   glGenBuffers(1, &r.overlayBuffer);
@@ -329,6 +346,9 @@ Renderer::~Renderer() {
   glDeleteVertexArrays(1, &r.groundVao);
   glDeleteBuffers(1, &r.groundBuffer);
   glDeleteVertexArrays(1, &r.overlayVao);
+  glDeleteVertexArrays(1, &r.colliderVao);
+  const GLuint colliderBuffers[] = {r.colliderPositions, r.colliderNormals, r.colliderIndices};
+  glDeleteBuffers(3, colliderBuffers);
   glDeleteBuffers(1, &r.overlayBuffer);
 }
 
@@ -342,8 +362,24 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   if (world.topologyVersion() != r.topologyVersion || r.cloths.size() != world.cloths().size()) {
     r.uploadTopology(world);
   }
-  for (std::size_t c = 0; c < world.cloths().size(); ++c)
+  for (std::size_t c = 0; c < world.cloths().size(); ++c) {
     r.streamCloth(world.cloths()[c], r.cloths[c], options.strainMap);
+  }
+  r.colliderGeometry.clear();
+  for (const sim::Collider& collider : world.colliders()) appendColliderGeometry(collider, r.colliderGeometry);
+  const auto colliderIndexCount = static_cast<GLsizei>(r.colliderGeometry.indices.size());
+  if (colliderIndexCount > 0) {
+    const ColliderGeometry& g = r.colliderGeometry;
+    glBindVertexArray(r.colliderVao);
+    glBindBuffer(GL_ARRAY_BUFFER, r.colliderPositions);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(g.positions.size() * sizeof(glm::vec3)), g.positions.data(),
+                 GL_STREAM_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, r.colliderNormals);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(g.normals.size() * sizeof(glm::vec3)), g.normals.data(),
+                 GL_STREAM_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(g.indices.size() * sizeof(std::uint32_t)),
+                 g.indices.data(), GL_STREAM_DRAW);
+  }
 
   // The light looks at the scene from kTowardsLight with an orthographic box around it.
   glm::dvec3 lower, upper;
@@ -371,6 +407,10 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
     if (gpu.triangleIndexCount == 0) continue;
     glBindVertexArray(gpu.vao);
     glDrawElements(GL_TRIANGLES, gpu.triangleIndexCount, GL_UNSIGNED_INT, nullptr);
+  }
+  if (colliderIndexCount > 0) {
+    glBindVertexArray(r.colliderVao);
+    glDrawElements(GL_TRIANGLES, colliderIndexCount, GL_UNSIGNED_INT, nullptr);
   }
 
   // Main pass, multisampled when the context can.
@@ -416,6 +456,16 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glUniform1i(uniform(r.clothProgram, "strainMap"), options.strainMap ? 1 : 0);
   glUniform1f(uniform(r.clothProgram, "strainScale"), std::max(1e-6f, options.strainScale));
   glUniform1i(uniform(r.clothProgram, "shadowMap"), 0);
+  if (colliderIndexCount > 0) {
+    glUniform1i(uniform(r.clothProgram, "twoSided"), 0);
+    glUniform1i(uniform(r.clothProgram, "strainMap"), 0);
+    setVec3(r.clothProgram, "frontColour", options.colliderColour);
+    glBindVertexArray(r.colliderVao);
+    glDrawElements(GL_TRIANGLES, colliderIndexCount, GL_UNSIGNED_INT, nullptr);
+    setVec3(r.clothProgram, "frontColour", options.frontColour);
+    glUniform1i(uniform(r.clothProgram, "strainMap"), options.strainMap ? 1 : 0);
+  }
+  glUniform1i(uniform(r.clothProgram, "twoSided"), 1);
   for (const GpuCloth& gpu : r.cloths) {
     if (gpu.triangleIndexCount == 0) continue;
     glBindVertexArray(gpu.vao);

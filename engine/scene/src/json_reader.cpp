@@ -73,6 +73,13 @@ std::string ObjectReader::text(std::string_view key, std::string fallback) {
   return value->get<std::string>();
 }
 
+bool ObjectReader::boolean(std::string_view key, bool fallback) {
+  const nlohmann::json* value = find(key);
+  if (!value) return fallback;
+  if (!value->is_boolean()) fail(key, "true or false", value);
+  return value->get<bool>();
+}
+
 std::string ObjectReader::choice(std::string_view key, std::string fallback,
                                  std::initializer_list<std::string_view> choices) {
   const nlohmann::json* value = find(key);

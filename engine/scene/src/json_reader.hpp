@@ -30,6 +30,7 @@ class ObjectReader {
   double number(std::string_view key, double fallback, const Range& range);
   int integer(std::string_view key, int fallback, int min, int max);
   std::string text(std::string_view key, std::string fallback);
+  bool boolean(std::string_view key, bool fallback);
   std::string choice(std::string_view key, std::string fallback, std::initializer_list<std::string_view> choices);
   sim::Vec3 vec3(std::string_view key, sim::Vec3 fallback, double maxAbs, std::string_view unit);
   ObjectReader object(std::string_view key);

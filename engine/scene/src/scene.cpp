@@ -1,12 +1,13 @@
 #include "drape/scene/scene.hpp"
 
 #include <charconv>
-#include <set>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "colliders.hpp"
 #include "drape/scene/error.hpp"
 #include "json_reader.hpp"
 
@@ -20,6 +21,7 @@ using sim::KindMaterial;
 using sim::Model;
 
 constexpr int kMaxCloths = 64;
+constexpr int kMaxColliders = 256;
 constexpr std::size_t kMaxPins = 100000;
 constexpr double kMaxCoordinate = 1.0e4;  // m
 
@@ -80,6 +82,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
   lattice.plane = reader.choice("plane", "xz", {"xz", "xy"}) == "xz" ? sim::LatticePlane::xz : sim::LatticePlane::xy;
   cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
   cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
+  cloth.thickness = reader.number("thickness", cloth.thickness, {1.0e-4, 0.1, false, "m"});
   for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model);
 
   const json& pins = reader.array("pins", kMaxPins);
@@ -137,6 +140,15 @@ Scene parseScene(const json& document, const std::string& source) {
     world.air.drag = wind.number("drag", 0.0, {0.0, 1000.0, false, "1/s"});
     world.air.pressure = wind.number("pressure", 0.0, {0.0, 1.0e4, false, "kg/(m^2 s)"});
     wind.finish();
+  }
+  const json& colliders = root.array("colliders", kMaxColliders);
+  for (std::size_t i = 0; i < colliders.size(); ++i) {
+    ObjectReader collider(colliders[i], "colliders." + std::to_string(i), source);
+    world.colliders.push_back(readCollider(collider, source));
+  }
+  if (root.has("selfCollision")) {
+    ObjectReader self = root.object("selfCollision");
+    world.selfCollision = readSelfCollision(self);
   }
   const json& cloths = root.array("cloths", kMaxCloths);
   long long particleBudget = sim::kMaxParticles;
@@ -215,7 +227,8 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
   const json::parser_callback_t rejectDuplicateKeys = [&](int, json::parse_event_t event, json& parsed) {
     if (event == json::parse_event_t::object_start) keysSeen.emplace_back();
     if (event == json::parse_event_t::object_end && !keysSeen.empty()) keysSeen.pop_back();
-    if (event == json::parse_event_t::key && !keysSeen.empty() && !keysSeen.back().insert(parsed.get<std::string>()).second) {
+    if (event == json::parse_event_t::key && !keysSeen.empty() &&
+        !keysSeen.back().insert(parsed.get<std::string>()).second) {
       throw InputError(source + ": key " + describe(parsed) + " appears twice in one object");
     }
     return true;

@@ -151,6 +151,8 @@ void startHistory(Cloth& cloth, const WorldSettings& world, Real h, SolverScratc
 }
 
 void step(Integrator integrator, Cloth& cloth, const WorldSettings& world, Real h, SolverScratch& scratch) {
+  // Collisions sweep each particle's motion from where the step started (Verlet keeps it anyway).
+  if (integrator != Integrator::verlet && !world.colliders.empty()) cloth.state.previousPosition = cloth.state.position;
   switch (integrator) {
     case Integrator::explicitEuler: explicitEuler(cloth, world, h, scratch); break;
     case Integrator::symplecticEuler: symplecticEuler(cloth, world, h, scratch); break;

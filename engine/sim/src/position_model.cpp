@@ -1,6 +1,7 @@
 #include "position_model.hpp"
 
 #include "aerodynamics.hpp"
+#include "contacts.hpp"
 
 #include <cmath>
 
@@ -70,7 +71,7 @@ void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inver
   position[c.b] -= wb * correction;
 }
 
-void projectConstraints(Cloth& cloth, int iterations) {
+void projectConstraints(Cloth& cloth, int iterations, SolverScratch* contacts) {
   ParticleState& s = cloth.state;
   for (int iteration = 0; iteration < iterations; ++iteration) {
     for (ConstraintKind kind : kConstraintKinds) {
@@ -78,6 +79,7 @@ void projectConstraints(Cloth& cloth, int iterations) {
       if (stiffness == 0.0) continue;
       for (const DistanceConstraint& c : cloth.rest.of(kind)) projectDistance(s.position, s.inverseMass, c, stiffness);
     }
+    if (contacts) contact::project(cloth, *contacts);
   }
 }
 

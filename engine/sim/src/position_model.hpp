@@ -32,7 +32,9 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
 // stiffness k:  dx_a = k w_a / (w_a + w_b) (|x_b - x_a| - r) (x_b - x_a) / |x_b - x_a|,
 //               dx_b = -k w_b / (w_a + w_b) (...)
 // With equal masses and k = 1 that is exactly the seed's dx_1 = 1/2 (|x2 - x1| - r)(x2 - x1)/|x2 - x1|.
-void projectConstraints(Cloth& cloth, int iterations);
+// With `contacts`, the contact planes are re-enforced after every sweep, so the constraints cannot
+// pull a particle back into a collider.
+void projectConstraints(Cloth& cloth, int iterations, SolverScratch* contacts);
 
 // Removes the kind's damping fraction of the relative velocity along each constraint, by moving
 // x_prev, conserving momentum.

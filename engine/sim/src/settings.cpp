@@ -43,6 +43,11 @@ std::string_view name(Stage stage) {
     case Stage::verletIntegrate: return "verlet integrate";
     case Stage::projectConstraints: return "project constraints";
     case Stage::dampConstraints: return "damp constraints";
+    case Stage::clampTravel: return "clamp travel";
+    case Stage::collide: return "collide";
+    case Stage::friction: return "friction";
+    case Stage::selfCollide: return "self-collide";
+    case Stage::collideForces: return "collide (forces)";
     case Stage::explicitEuler: return "explicit euler";
     case Stage::symplecticEuler: return "symplectic euler";
     case Stage::verletForces: return "verlet (forces)";

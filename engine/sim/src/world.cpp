@@ -9,6 +9,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "contacts.hpp"
 #include "force_model.hpp"
 #include "position_model.hpp"
 
@@ -57,6 +58,33 @@ void validate(const WorldSettings& s) {
     }
   }
   require(particles <= kMaxParticles, "too many particles");
+  for (const ClothSettings& cloth : s.cloths) {
+    require(finite(cloth.thickness) && cloth.thickness > 0.0, "cloth thickness must be positive");
+  }
+  const SelfCollisionSettings& self = s.selfCollision;
+  require(finite(self.distance) && self.distance > 0.0 && finite(self.friction) && self.friction >= 0.0 &&
+              self.friction <= 1.0 && finite(self.maxTravel) && self.maxTravel > 0.0,
+          "self-collision distance must be positive, friction in 0..1, maxTravel positive");
+  for (const ColliderSettings& c : s.colliders) {
+    require(finite(c.position) && finite(c.velocity) && finite(c.angularVelocity), "collider numbers must be finite");
+    require(finite(c.friction.staticCoefficient) && c.friction.staticCoefficient >= 0.0 &&
+                finite(c.friction.kineticCoefficient) && c.friction.kineticCoefficient >= 0.0,
+            "collider friction must be finite and >= 0");
+    switch (c.shape) {
+      case ColliderShape::plane:
+        require(finite(c.normal) && glm::length(c.normal) > 0.0, "plane normal must not be zero");
+        break;
+      case ColliderShape::sphere:
+      case ColliderShape::capsule:
+        require(finite(c.radius) && c.radius > 0.0, "collider radius must be positive");
+        break;
+      case ColliderShape::box:
+        require(finite(c.halfExtents) && glm::all(glm::greaterThan(c.halfExtents, Vec3{0.0})),
+                "box half extents must be positive");
+        break;
+      case ColliderShape::mesh: require(c.mesh && !c.mesh->triangles.empty(), "mesh collider has no triangles"); break;
+    }
+  }
 }
 
 bool used(const KindMaterial& m) { return m.stiffness > 0.0 || m.damping > 0.0; }
@@ -121,15 +149,23 @@ World::World(WorldSettings settings) : settings_(std::move(settings)), topologyV
     }
   }
   scratch_.resize(cloths_.size());
+  for (const ColliderSettings& collider : settings_.colliders) colliders_.emplace_back(collider);
+  const bool anyColliders = !colliders_.empty();
+  const bool selfCollision = settings_.selfCollision.enabled && model == Model::position;
 
   const auto add = [this](Stage stage, bool perSubstep) { profile_.push_back({stage, perSubstep}); };
   if (model == Model::position) {
     if (settings_.air.pressure > 0.0 && anyTriangles) add(Stage::windPressure, true);
     add(Stage::verletIntegrate, true);
+    if (selfCollision) add(Stage::clampTravel, true);
+    if (anyColliders) add(Stage::collide, true);
     if (anyProjected && settings_.solver.iterations > 0) add(Stage::projectConstraints, true);
+    if (anyColliders) add(Stage::friction, true);
+    if (selfCollision) add(Stage::selfCollide, true);
     if (anyDamped) add(Stage::dampConstraints, true);
   } else {
     add(integratorStage(settings_.solver.integrator), true);
+    if (anyColliders) add(Stage::collideForces, true);
   }
   add(Stage::guard, false);
 }
@@ -171,8 +207,25 @@ void World::runStage(Stage stage) {
       case Stage::verletIntegrate:
         position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration);
         break;
-      case Stage::projectConstraints: position::projectConstraints(cloth, settings_.solver.iterations); break;
+      case Stage::projectConstraints:
+        position::projectConstraints(cloth, settings_.solver.iterations, colliders_.empty() ? nullptr : &scratch);
+        break;
       case Stage::dampConstraints: position::dampConstraints(cloth); break;
+      case Stage::clampTravel:
+        contact::clampTravel(cloth, settings_.selfCollision.maxTravel * settings_.selfCollision.distance);
+        break;
+      case Stage::collide:
+        if (c == 0) moveColliders();
+        contact::detect(cloth, colliders_, scratch);
+        break;
+      case Stage::friction: contact::friction(cloth, colliders_, h, scratch); break;
+      case Stage::selfCollide:
+        if (c == 0) contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_);
+        break;
+      case Stage::collideForces:
+        if (c == 0) moveColliders();
+        contact::respondWithVelocities(cloth, colliders_, h, scratch);
+        break;
       case Stage::explicitEuler:
       case Stage::symplecticEuler:
       case Stage::verletForces:
@@ -180,6 +233,15 @@ void World::runStage(Stage stage) {
       case Stage::rk4: force::step(settings_.solver.integrator, cloth, settings_, h, scratch); break;
       case Stage::guard: break;
     }
+  }
+}
+
+void World::moveColliders() {
+  // Contacts are made against where the colliders are at the end of the current substep.
+  const Real end = (static_cast<Real>(stepCount_) + static_cast<Real>(substep_ + 1) / settings_.solver.substeps) *
+                   settings_.solver.dt;
+  for (Collider& collider : colliders_) {
+    if (collider.moving()) collider.setTime(end);
   }
 }
 
@@ -191,7 +253,8 @@ std::optional<Divergence> World::findBadParticle() const {
       const bool bad = !finite(x) ||
                        !(glm::abs(x.x) <= kRunawayDistance && glm::abs(x.y) <= kRunawayDistance &&
                          glm::abs(x.z) <= kRunawayDistance) ||
-                       (!s.velocity.empty() && !(glm::length(s.velocity[i]) <= kRunawaySpeed)) || !finite(s.previousPosition[i]);
+                       (!s.velocity.empty() && !(glm::length(s.velocity[i]) <= kRunawaySpeed)) ||
+                       !finite(s.previousPosition[i]);
       if (bad) return Divergence{stepCount_ + 1, static_cast<int>(c), static_cast<ParticleIndex>(i)};
     }
   }
@@ -207,6 +270,7 @@ StepStatus World::step() {
 
   for (StageTiming& timing : profile_) timing.lastSeconds = 0.0;
   for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
+    substep_ = substep;
     for (StageTiming& timing : profile_) {
       if (!timing.perSubstep) continue;
       const auto start = Clock::now();

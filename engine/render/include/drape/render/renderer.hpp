@@ -3,7 +3,7 @@
 //
 // What it draws: each cloth as a smooth two-sided lit surface (normals recomputed every frame, a
 // front and a back colour, optionally a strain colour map); a chain as links and beads; the table
-// (y = 0) with a soft shadow of the cloth; pins as round markers; and an overlay of finger rings
+// (y = 0) with a soft shadow of the cloth; colliders as grey solids; pins as round markers; and an overlay of finger rings
 // and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry.
 // Positions and normals stream every frame into buffers allocated once; index buffers are
 // re-uploaded only when the world's topology version changes.
@@ -53,6 +53,7 @@ struct FrameOptions {
   glm::vec3 frontColour{0.85f, 0.33f, 0.18f};
   glm::vec3 backColour{0.20f, 0.52f, 0.62f};
   glm::vec3 backgroundColour{0.62f, 0.66f, 0.70f};
+  glm::vec3 colliderColour{0.55f, 0.56f, 0.60f};
 };
 
 class Renderer {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "drape/sim/cloth.hpp"
+#include "drape/sim/collider.hpp"
 #include "drape/sim/types.hpp"
 
 namespace drape::sim {
@@ -68,6 +69,7 @@ struct ClothSettings {
   LatticeSpec lattice;
   Real mass = 1.0;            // kg, spread evenly over the particles
   Vec3 initialVelocity{0.0};  // m/s, of every unpinned particle at the start
+  Real thickness = 0.005;     // m, how close a particle comes to a collider's surface
   std::array<KindMaterial, kConstraintKindCount> materials{};
   std::vector<Pin> pins;
 
@@ -75,11 +77,22 @@ struct ClothSettings {
   const KindMaterial& material(ConstraintKind kind) const { return materials[static_cast<std::size_t>(kind)]; }
 };
 
+// Particles keeping apart, within a cloth and between cloths (Ten Minute Physics 15; Teschner et
+// al. 2003 hashing).
+struct SelfCollisionSettings {
+  bool enabled = false;
+  Real distance = 0.01;  // m, closest two particles may come (unless closer at rest in one cloth)
+  Real friction = 0.2;   // 0..1, share of their relative velocity removed on contact
+  Real maxTravel = 0.5;  // fraction of `distance` a particle may move per substep (no crossing)
+};
+
 struct WorldSettings {
   SolverSettings solver;
   Vec3 gravity{0.0, -9.81, 0.0};  // m/s^2
   AirSettings air;
   std::vector<ClothSettings> cloths;
+  std::vector<ColliderSettings> colliders;
+  SelfCollisionSettings selfCollision;
 };
 
 // Limits the engine accepts; the scene layer reports them to the user.

@@ -2,6 +2,7 @@
 // needs and nothing else.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "drape/sim/types.hpp"
@@ -27,6 +28,21 @@ struct SolverScratch {
   std::vector<Vec3> trialVelocity;  // ... and v there
   std::vector<Vec3> sumPosition;    // rk4: weighted sum of the stages' dx/dt
   std::vector<Vec3> sumVelocity;    // rk4: weighted sum of the stages' dv/dt
+  // Contacts, only when the world has colliders: per particle the contact plane n . x >= offset.
+  std::vector<std::int32_t> contactCollider;  // -1: none
+  std::vector<Vec3> contactNormal;
+  std::vector<Real> contactOffset;  // m
+  std::vector<Real> contactDepth;   // m, penetration resolved this substep (for friction)
+};
+
+// The self-collision spatial hash over every particle of a world.
+struct SelfCollisionScratch {
+  struct Owner {
+    std::uint32_t cloth;
+    std::uint32_t particle;
+  };
+  std::vector<Owner> owner;  // hash entry -> particle
+  std::vector<std::uint32_t> start, fill, entries;
 };
 
 }  // namespace drape::sim

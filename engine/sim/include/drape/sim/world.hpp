@@ -42,6 +42,7 @@ class World {
 
   const WorldSettings& settings() const { return settings_; }
   const std::vector<Cloth>& cloths() const { return cloths_; }
+  const std::vector<Collider>& colliders() const { return colliders_; }
   std::int64_t stepCount() const { return stepCount_; }
   double time() const { return static_cast<double>(stepCount_) * settings_.solver.dt; }
   double substepDt() const { return settings_.solver.dt / settings_.solver.substeps; }
@@ -58,6 +59,7 @@ class World {
  private:
   void runStage(Stage stage);
   void startHistory();
+  void moveColliders();
   std::optional<Divergence> findBadParticle() const;
 
   WorldSettings settings_;
@@ -67,7 +69,10 @@ class World {
   std::uint64_t topologyVersion_ = 0;
   bool historyStarted_ = false;
   std::optional<Divergence> divergence_;
-  std::vector<SolverScratch> scratch_;   // per cloth
+  std::vector<SolverScratch> scratch_;  // per cloth
+  std::vector<Collider> colliders_;
+  SelfCollisionScratch selfCollisionScratch_;
+  int substep_ = 0;                      // within the current step
   std::vector<ParticleState> lastGood_;  // state before the current step
 };
 

@@ -1,0 +1,123 @@
+#include "colliders.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include <tiny_obj_loader.h>
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "drape/scene/error.hpp"
+
+namespace drape::scene {
+
+namespace {
+
+constexpr double kMaxCoordinate = 1.0e4;  // m
+constexpr double kDegrees = 3.14159265358979323846 / 180.0;
+
+glm::dquat fromDegrees(sim::Vec3 degrees) { return glm::dquat(degrees * kDegrees); }  // Euler x, y, z
+
+std::shared_ptr<const sim::TriangleMesh> loadObj(ObjectReader& reader, const std::string& sceneSource, double scale) {
+  const std::string file = reader.text("file", "");
+  if (file.empty()) reader.fail("file", "the path of an OBJ file (relative to the scene file)", reader.raw("file"));
+  const std::filesystem::path path = std::filesystem::path(sceneSource).parent_path() / file;
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = false;
+  tinyobj::ObjReader obj;
+  const bool ok = std::filesystem::is_regular_file(path) && obj.ParseFromFile(path.string(), config);
+  auto mesh = std::make_shared<sim::TriangleMesh>();
+  if (ok) {
+    const std::vector<tinyobj::real_t>& v = obj.GetAttrib().vertices;
+    for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
+      mesh->vertices.push_back(sim::Vec3{v[i], v[i + 1], v[i + 2]} * scale);
+    }
+    for (const tinyobj::shape_t& shape : obj.GetShapes()) {
+      const auto& indices = shape.mesh.indices;
+      for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
+        const int a = indices[i].vertex_index, b = indices[i + 1].vertex_index, c = indices[i + 2].vertex_index;
+        const auto count = static_cast<int>(mesh->vertices.size());
+        if (a < 0 || b < 0 || c < 0 || a >= count || b >= count || c >= count) {
+          reader.fail("file", "an OBJ whose faces index its vertices (" + path.string() + " has one that does not)",
+                      nullptr);
+        }
+        mesh->triangles.push_back({a, b, c});
+      }
+    }
+  }
+  bool finiteVertices = true;
+  for (const sim::Vec3& p : mesh->vertices) finiteVertices = finiteVertices && std::isfinite(p.x + p.y + p.z);
+  if (!ok || mesh->triangles.empty() || !finiteVertices) {
+    std::string why = !std::filesystem::is_regular_file(path) ? "it does not exist"
+                      : !ok                                   ? obj.Error()
+                                                              : "it has no triangles";
+    if (!finiteVertices) why = "it has non-finite vertices";
+    for (char& ch : why) ch = ch == '\n' ? ' ' : ch;
+    throw InputError(reader.source() + ": " + reader.pathOf("file") + ": cannot use the OBJ file " + path.string() +
+                     ": " + why);
+  }
+  return mesh;
+}
+
+}  // namespace
+
+sim::ColliderSettings readCollider(ObjectReader& reader, const std::string& sceneSource) {
+  sim::ColliderSettings c;
+  const std::string type = reader.choice("type", "", {"plane", "sphere", "capsule", "box", "mesh"});
+  if (type.empty()) reader.fail("type", "one of \"plane\" \"sphere\" \"capsule\" \"box\" \"mesh\"", nullptr);
+  const Range radius{0.0, 1000.0, true, "m"};
+  if (type == "plane") {
+    c.shape = sim::ColliderShape::plane;
+    c.position = reader.vec3("point", sim::Vec3{0.0}, kMaxCoordinate, "m");
+    c.normal = reader.vec3("normal", sim::Vec3{0.0, 1.0, 0.0}, 1.0e6, "");
+    if (!(glm::length(c.normal) > 1e-9)) reader.fail("normal", "a non-zero vector", reader.raw("normal"));
+  } else if (type == "sphere") {
+    c.shape = sim::ColliderShape::sphere;
+    c.position = reader.vec3("centre", sim::Vec3{0.0}, kMaxCoordinate, "m");
+    c.radius = reader.number("radius", 0.5, radius);
+  } else if (type == "capsule") {
+    c.shape = sim::ColliderShape::capsule;
+    const sim::Vec3 from = reader.vec3("from", sim::Vec3{-0.5, 0.0, 0.0}, kMaxCoordinate, "m");
+    const sim::Vec3 to = reader.vec3("to", sim::Vec3{0.5, 0.0, 0.0}, kMaxCoordinate, "m");
+    c.position = (from + to) * 0.5;
+    c.halfAxis = (to - from) * 0.5;
+    c.radius = reader.number("radius", 0.1, radius);
+  } else if (type == "box") {
+    c.shape = sim::ColliderShape::box;
+    c.position = reader.vec3("centre", sim::Vec3{0.0}, kMaxCoordinate, "m");
+    c.halfExtents = reader.vec3("halfExtents", sim::Vec3{0.5}, 1000.0, "m");
+    if (!glm::all(glm::greaterThan(c.halfExtents, sim::Vec3{0.0}))) {
+      reader.fail("halfExtents", "three positive numbers (m)", reader.raw("halfExtents"));
+    }
+    c.orientation = fromDegrees(reader.vec3("rotation", sim::Vec3{0.0}, 3600.0, "degrees about x, y, z"));
+  } else {
+    c.shape = sim::ColliderShape::mesh;
+    c.position = reader.vec3("translate", sim::Vec3{0.0}, kMaxCoordinate, "m");
+    c.orientation = fromDegrees(reader.vec3("rotation", sim::Vec3{0.0}, 3600.0, "degrees about x, y, z"));
+    c.mesh = loadObj(reader, sceneSource, reader.number("scale", 1.0, {0.0, 1000.0, true, ""}));
+  }
+  if (reader.has("friction")) {
+    ObjectReader friction = reader.object("friction");
+    c.friction.staticCoefficient = friction.number("static", 0.5, {0.0, 10.0, false, ""});
+    c.friction.kineticCoefficient =
+        friction.number("kinetic", c.friction.staticCoefficient * 0.8, {0.0, 10.0, false, ""});
+    friction.finish();
+  }
+  c.velocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
+  c.angularVelocity = reader.vec3("angularVelocity", sim::Vec3{0.0}, 36000.0, "degrees/s") * kDegrees;
+  reader.finish();
+  return c;
+}
+
+sim::SelfCollisionSettings readSelfCollision(ObjectReader& reader) {
+  sim::SelfCollisionSettings s;
+  s.enabled = reader.boolean("enabled", true);
+  s.distance = reader.number("distance", s.distance, {1.0e-4, 1.0, false, "m"});
+  s.friction = reader.number("friction", s.friction, {0.0, 1.0, false, "share of relative velocity removed"});
+  s.maxTravel = reader.number("maxTravel", s.maxTravel, {0.01, 10.0, false, "distances per substep"});
+  reader.finish();
+  return s;
+}
+
+}  // namespace drape::scene

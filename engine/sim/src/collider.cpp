@@ -1,0 +1,168 @@
+#include "drape/sim/collider.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+namespace drape::sim {
+
+Collider::Collider(ColliderSettings settings) : settings_(std::move(settings)) {
+  if (settings_.shape == ColliderShape::plane) settings_.normal = glm::normalize(settings_.normal);
+  setTime(0.0);
+  if (settings_.shape == ColliderShape::mesh) buildGrid();
+}
+
+bool Collider::moving() const {
+  return glm::length(settings_.velocity) > 0.0 || glm::length(settings_.angularVelocity) > 0.0;
+}
+
+void Collider::setTime(Real t) {
+  centre_ = settings_.position + settings_.velocity * t;
+  const Real spin = glm::length(settings_.angularVelocity);
+  orientation_ = spin > 0.0 ? glm::angleAxis(spin * t, settings_.angularVelocity / spin) * settings_.orientation
+                            : settings_.orientation;
+}
+
+Vec3 Collider::surfaceVelocity(Vec3 p) const {
+  return settings_.velocity + glm::cross(settings_.angularVelocity, p - centre_);
+}
+
+SurfaceDistance Collider::distance(Vec3 p, Real reach) const {
+  const Vec3 inFrame = glm::conjugate(orientation_) * (p - centre_);
+  SurfaceDistance d = local(inFrame, reach);
+  d.normal = orientation_ * d.normal;
+  return d;
+}
+
+Vec3 closestPointOnTriangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const Real d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  const Vec3 bp = p - b;
+  const Real d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  const Real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - c;
+  const Real d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  const Real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + ac * (d2 / (d2 - d6));
+  const Real va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const Real denominator = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denominator) + ac * (vc * denominator);
+}
+
+namespace {
+
+Vec3 unitOr(Vec3 v, Vec3 fallback) {
+  const Real length = glm::length(v);
+  return length > 1e-12 ? v / length : fallback;
+}
+
+}  // namespace
+
+SurfaceDistance Collider::local(Vec3 p, Real reach) const {
+  const ColliderSettings& s = settings_;
+  switch (s.shape) {
+    case ColliderShape::plane: return {glm::dot(s.normal, p), s.normal};
+    case ColliderShape::sphere: return {glm::length(p) - s.radius, unitOr(p, Vec3{0.0, 1.0, 0.0})};
+    case ColliderShape::capsule: {
+      const Real axisLength2 = glm::dot(s.halfAxis, s.halfAxis);
+      const Real t = axisLength2 > 0.0 ? std::clamp(glm::dot(p, s.halfAxis) / axisLength2, -1.0, 1.0) : 0.0;
+      const Vec3 away = p - s.halfAxis * t;
+      return {glm::length(away) - s.radius, unitOr(away, Vec3{0.0, 1.0, 0.0})};
+    }
+    case ColliderShape::box: {
+      const Vec3 q = glm::abs(p) - s.halfExtents;
+      const Vec3 outside = glm::max(q, Vec3{0.0});
+      const Real outsideLength = glm::length(outside);
+      if (outsideLength > 0.0) return {outsideLength, glm::sign(p) * outside / outsideLength};
+      // Inside: the nearest face is along the axis with the largest (least negative) q.
+      int axis = 0;
+      if (q.y > q[axis]) axis = 1;
+      if (q.z > q[axis]) axis = 2;
+      Vec3 normal{0.0};
+      normal[axis] = p[axis] >= 0.0 ? 1.0 : -1.0;
+      return {q[axis], normal};
+    }
+    case ColliderShape::mesh: {
+      SurfaceDistance best{reach, Vec3{0.0, 1.0, 0.0}};
+      if (gridCells_.x == 0) return best;
+      const glm::ivec3 lower =
+          glm::clamp(glm::ivec3(glm::floor((p - reach - gridOrigin_) / cellSize_)), glm::ivec3(0), gridCells_ - 1);
+      const glm::ivec3 upper =
+          glm::clamp(glm::ivec3(glm::floor((p + reach - gridOrigin_) / cellSize_)), glm::ivec3(0), gridCells_ - 1);
+      if (glm::any(glm::greaterThan(
+              glm::abs(p - glm::clamp(p, gridOrigin_, gridOrigin_ + Vec3(gridCells_) * cellSize_)), Vec3{reach}))) {
+        return best;  // the whole mesh is out of reach
+      }
+      const TriangleMesh& mesh = *s.mesh;
+      for (int z = lower.z; z <= upper.z; ++z) {
+        for (int y = lower.y; y <= upper.y; ++y) {
+          for (int x = lower.x; x <= upper.x; ++x) {
+            const int cell = (z * gridCells_.y + y) * gridCells_.x + x;
+            for (std::uint32_t k = cellStart_[cell]; k < cellStart_[cell + 1]; ++k) {
+              const glm::uvec3& t = mesh.triangles[cellTriangles_[k]];
+              const Vec3 closest =
+                  closestPointOnTriangle(p, mesh.vertices[t.x], mesh.vertices[t.y], mesh.vertices[t.z]);
+              const Real d = glm::length(p - closest);
+              if (d < best.distance) {
+                const Vec3 faceNormal =
+                    glm::cross(mesh.vertices[t.y] - mesh.vertices[t.x], mesh.vertices[t.z] - mesh.vertices[t.x]);
+                // A shell has two sides: the normal points to the side p is on.
+                best = {d, unitOr(p - closest, unitOr(faceNormal, Vec3{0.0, 1.0, 0.0}))};
+              }
+            }
+          }
+        }
+      }
+      return best;
+    }
+  }
+  return {std::numeric_limits<Real>::max(), Vec3{0.0, 1.0, 0.0}};
+}
+
+void Collider::buildGrid() {
+  const TriangleMesh& mesh = *settings_.mesh;
+  if (mesh.triangles.empty()) return;
+  Vec3 lower{std::numeric_limits<Real>::max()}, upper{std::numeric_limits<Real>::lowest()};
+  Real edges = 0.0;
+  for (const glm::uvec3& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      lower = glm::min(lower, mesh.vertices[t[k]]);
+      upper = glm::max(upper, mesh.vertices[t[k]]);
+      edges += glm::length(mesh.vertices[t[(k + 1) % 3]] - mesh.vertices[t[k]]);
+    }
+  }
+  // Cells about two average edges wide, at most 128 along any axis.
+  const Vec3 size = upper - lower;
+  cellSize_ = std::max({2.0 * edges / (3.0 * static_cast<Real>(mesh.triangles.size())),
+                        std::max({size.x, size.y, size.z}) / 128.0, 1e-6});
+  gridOrigin_ = lower - cellSize_ * 0.5;
+  gridCells_ = glm::ivec3(glm::floor((size + cellSize_) / cellSize_)) + 1;
+  const std::size_t cellCount = static_cast<std::size_t>(gridCells_.x) * gridCells_.y * gridCells_.z;
+  std::vector<std::vector<std::uint32_t>> cells(cellCount);
+  for (std::uint32_t i = 0; i < mesh.triangles.size(); ++i) {
+    const glm::uvec3& t = mesh.triangles[i];
+    const Vec3 a = mesh.vertices[t.x], b = mesh.vertices[t.y], c = mesh.vertices[t.z];
+    const glm::ivec3 from = glm::ivec3(glm::floor((glm::min(a, glm::min(b, c)) - gridOrigin_) / cellSize_));
+    const glm::ivec3 to = glm::ivec3(glm::floor((glm::max(a, glm::max(b, c)) - gridOrigin_) / cellSize_));
+    for (int z = from.z; z <= to.z; ++z) {
+      for (int y = from.y; y <= to.y; ++y) {
+        for (int x = from.x; x <= to.x; ++x)
+          cells[static_cast<std::size_t>((z * gridCells_.y + y) * gridCells_.x + x)].push_back(i);
+      }
+    }
+  }
+  cellStart_.assign(cellCount + 1, 0);
+  for (std::size_t i = 0; i < cellCount; ++i)
+    cellStart_[i + 1] = cellStart_[i] + static_cast<std::uint32_t>(cells[i].size());
+  cellTriangles_.reserve(cellStart_.back());
+  for (const auto& cell : cells) cellTriangles_.insert(cellTriangles_.end(), cell.begin(), cell.end());
+}
+
+}  // namespace drape::sim

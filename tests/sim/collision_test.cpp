@@ -1,0 +1,281 @@
+// Collisions: no penetration, Coulomb friction on a slope against its closed form, no tunnelling,
+// self-collision keeping layers apart, and no collision stage where nothing collides.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "drape/sim/collider.hpp"
+#include "drape/sim/world.hpp"
+#include "world_builder.hpp"
+
+namespace drape::sim {
+namespace {
+
+ColliderSettings plane(Vec3 point, Vec3 normal, Real mu) {
+  ColliderSettings c;
+  c.shape = ColliderShape::plane;
+  c.position = point;
+  c.normal = normal;
+  c.friction = {mu, mu};
+  return c;
+}
+
+ColliderSettings sphere(Vec3 centre, Real radius) {
+  ColliderSettings c;
+  c.shape = ColliderShape::sphere;
+  c.position = centre;
+  c.radius = radius;
+  return c;
+}
+
+ColliderSettings box(Vec3 centre, Vec3 halfExtents, glm::dquat orientation = {1.0, 0.0, 0.0, 0.0}) {
+  ColliderSettings c;
+  c.shape = ColliderShape::box;
+  c.position = centre;
+  c.halfExtents = halfExtents;
+  c.orientation = orientation;
+  return c;
+}
+
+WorldSettings sheetAbove(int n, double height, double size = 1.0) {
+  WorldSettings world = test::hangingSheet(n, 10, 4);
+  world.cloths[0].pins.clear();
+  world.cloths[0].lattice.origin = Vec3{-size / 2, height, -size / 2};
+  world.cloths[0].lattice.width = world.cloths[0].lattice.height = size;
+  world.air.drag = 0.5;
+  return world;
+}
+
+// The deepest any particle is inside any collider (0 when none is), measured from the surface.
+Real deepestPenetration(const World& world) {
+  Real deepest = 0.0;
+  for (const Cloth& cloth : world.cloths()) {
+    for (const Vec3& x : cloth.state.position) {
+      for (const Collider& collider : world.colliders())
+        deepest = std::max(deepest, -collider.distance(x, 10.0).distance);
+    }
+  }
+  return deepest;
+}
+
+TEST(Colliders, SignedDistancesOfTheShapes) {
+  Collider ball(sphere({0, 1, 0}, 0.5));
+  EXPECT_NEAR(ball.distance({0, 2, 0}, 10).distance, 0.5, 1e-12);
+  EXPECT_NEAR(ball.distance({0, 1.25, 0}, 10).distance, -0.25, 1e-12);
+  Collider cube(box({0, 0, 0}, {1, 2, 3}));
+  EXPECT_NEAR(cube.distance({2, 0, 0}, 10).distance, 1.0, 1e-12);
+  EXPECT_NEAR(cube.distance({0, 1.5, 0}, 10).distance, -0.5, 1e-12);
+  EXPECT_NEAR(cube.distance({2, 3, 3}, 10).distance, std::sqrt(2.0), 1e-12);
+  // Turned 90 degrees about y, the box's long z side lies along x.
+  Collider turned(box({0, 0, 0}, {1, 2, 3}, glm::angleAxis(std::numbers::pi / 2, Vec3{0, 1, 0})));
+  EXPECT_NEAR(turned.distance({3.5, 0, 0}, 10).distance, 0.5, 1e-9);
+  ColliderSettings capsule;
+  capsule.shape = ColliderShape::capsule;
+  capsule.halfAxis = {1, 0, 0};
+  capsule.radius = 0.2;
+  EXPECT_NEAR(Collider(capsule).distance({0.5, 1, 0}, 10).distance, 0.8, 1e-12);
+  EXPECT_NEAR(Collider(capsule).distance({2, 0, 0}, 10).distance, 0.8, 1e-12);
+  Collider ground(plane({0, 1, 0}, {0, 2, 0}, 0.5));
+  EXPECT_NEAR(ground.distance({5, 0.5, 5}, 10).distance, -0.5, 1e-12);
+  EXPECT_NEAR(glm::length(ground.distance({5, 0.5, 5}, 10).normal - Vec3{0, 1, 0}), 0.0, 1e-12);
+}
+
+TEST(Colliders, AMovingColliderIsWhereItsMotionPutsIt) {
+  ColliderSettings s = sphere({0, 0, 0}, 0.5);
+  s.velocity = {0, 1, 0};
+  s.angularVelocity = {0, 2, 0};
+  Collider ball(s);
+  ball.setTime(2.0);
+  EXPECT_NEAR(ball.distance({0, 2, 0}, 10).distance, -0.5, 1e-12);
+  const Vec3 v = ball.surfaceVelocity({0.5, 2, 0});  // v + omega x r = (0,1,0) + (0,2,0) x (0.5,0,0)
+  EXPECT_NEAR(v.y, 1.0, 1e-12);
+  EXPECT_NEAR(v.z, -1.0, 1e-12);
+}
+
+class Drape : public ::testing::TestWithParam<int> {};
+
+TEST_P(Drape, SettledClothIsNowhereInsideAnyCollider) {
+  WorldSettings settings = sheetAbove(24, 1.0);
+  settings.colliders.push_back(plane({0, 0, 0}, {0, 1, 0}, 0.6));
+  switch (GetParam()) {
+    case 0: settings.colliders.push_back(sphere({0, 0.4, 0}, 0.3)); break;
+    case 1: settings.colliders.push_back(box({0, 0.3, 0}, {0.2, 0.3, 0.2}, glm::angleAxis(0.5, Vec3{0, 1, 0}))); break;
+    case 2: {
+      ColliderSettings capsule;
+      capsule.shape = ColliderShape::capsule;
+      capsule.position = {0, 0.4, 0};
+      capsule.halfAxis = {0.6, 0, 0};
+      capsule.radius = 0.1;
+      settings.colliders.push_back(capsule);
+      break;
+    }
+  }
+  World world(settings);
+  ASSERT_EQ(world.run(240), StepStatus::ok);
+  const Real thickness = settings.cloths[0].thickness;
+  EXPECT_LT(deepestPenetration(world), 1e-3);
+  // It rests on the collider: its highest particle is held up near the top of it.
+  Real highest = -1.0;
+  for (const Vec3& x : world.cloths()[0].state.position) highest = std::max(highest, x.y);
+  const Real top = GetParam() == 0 ? 0.7 : GetParam() == 1 ? 0.6 : 0.5;
+  EXPECT_NEAR(highest, top + thickness, 0.02);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shapes, Drape, ::testing::Values(0, 1, 2));
+
+// A particle on a slope of angle theta with Coulomb friction mu: it sticks when tan(theta) < mu, and
+// otherwise slides with a = g (sin(theta) - mu cos(theta)).
+double slideAlongSlope(double theta, double mu, double seconds) {
+  WorldSettings settings = test::singleParticle({0, 0, 0});
+  const Vec3 normal{-std::sin(theta), std::cos(theta), 0.0};
+  const Real thickness = settings.cloths[0].thickness;
+  settings.cloths[0].lattice.origin = normal * thickness;  // resting on the surface
+  settings.colliders.push_back(plane({0, 0, 0}, normal, mu));
+  settings.solver.dt = 1.0 / 600.0;
+  World world(settings);
+  world.run(static_cast<std::int64_t>(seconds * 600));
+  const Vec3 downhill{-std::cos(theta), -std::sin(theta), 0.0};
+  EXPECT_NEAR(glm::dot(world.cloths()[0].state.position[0], normal), thickness, 1e-6);  // still on the surface
+  return glm::dot(world.cloths()[0].state.position[0] - settings.cloths[0].lattice.origin, downhill);
+}
+
+TEST(Friction, OnASlopeItSticksBelowTheFrictionAngle) {
+  const double theta = 20.0 * std::numbers::pi / 180.0;  // tan = 0.36
+  EXPECT_NEAR(slideAlongSlope(theta, 0.5, 2.0), 0.0, 1e-6);
+}
+
+TEST(Friction, AboveTheFrictionAngleItSlidesAsCoulombSays) {
+  const double theta = 30.0 * std::numbers::pi / 180.0, mu = 0.3, t = 1.0;
+  const double expected = 0.5 * 9.81 * (std::sin(theta) - mu * std::cos(theta)) * t * t;
+  EXPECT_NEAR(slideAlongSlope(theta, mu, t), expected, 0.01 * expected);
+  const double frictionless = 0.5 * 9.81 * std::sin(theta) * t * t;
+  EXPECT_NEAR(slideAlongSlope(theta, 0.0, t), frictionless, 0.01 * frictionless);
+}
+
+TEST(Tunnelling, AFastDropDoesNotPassThroughAThinBox) {
+  // 50 m/s at 60 Hz moves 0.83 m a step; the board is 1 cm thick.
+  WorldSettings settings = sheetAbove(12, 0.5, 0.6);
+  settings.solver.substeps = 1;
+  settings.cloths[0].initialVelocity = {0, -50, 0};
+  settings.colliders.push_back(box({0, 0, 0}, {1, 0.005, 1}));
+  World world(settings);
+  ASSERT_EQ(world.run(60), StepStatus::ok);
+  for (const Vec3& x : world.cloths()[0].state.position) EXPECT_GT(x.y, 0.0);
+}
+
+TEST(Tunnelling, AFastDropDoesNotPassThroughAMeshShell) {
+  auto mesh = std::make_shared<TriangleMesh>();
+  mesh->vertices = {{-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}};
+  mesh->triangles = {{0, 2, 1}, {0, 3, 2}};
+  ColliderSettings shell;
+  shell.shape = ColliderShape::mesh;
+  shell.mesh = mesh;
+  WorldSettings settings = sheetAbove(12, 0.5, 0.6);
+  settings.solver.substeps = 1;
+  settings.cloths[0].initialVelocity = {0, -40, 0};
+  settings.colliders.push_back(shell);
+  World world(settings);
+  ASSERT_EQ(world.run(60), StepStatus::ok);
+  for (const Vec3& x : world.cloths()[0].state.position) EXPECT_GT(x.y, 0.0);
+}
+
+// Smallest distance between two particles that are far apart at rest (not neighbours).
+Real closestNonNeighbours(const Cloth& cloth, Real restApart) {
+  Real closest = 1e9;
+  const auto& x = cloth.state.position;
+  const auto& r = cloth.rest.restPositions;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    for (std::size_t j = i + 1; j < x.size(); ++j) {
+      if (glm::length(r[i] - r[j]) > restApart) closest = std::min(closest, glm::length(x[i] - x[j]));
+    }
+  }
+  return closest;
+}
+
+TEST(SelfCollision, ACurtainFallingInAHeapLiesOnItselfInLayers) {
+  // A hanging sheet released above the table folds onto itself as it lands.
+  struct Heap {
+    Real closest;  // m, between particles far apart at rest
+    int stacked;   // particles resting on others rather than on the table
+  };
+  const auto heap = [](bool selfCollision) {
+    WorldSettings settings;
+    settings.solver.substeps = 8;
+    settings.solver.iterations = 5;
+    settings.air.drag = 0.5;
+    ClothSettings cloth;
+    cloth.lattice = {12, 24, 0.5, 1.0, Vec3{-0.25, 1.1, 0.0}, LatticePlane::xy};
+    cloth.material(ConstraintKind::bend) = {0.05, 0.0};
+    settings.cloths.push_back(cloth);
+    settings.colliders.push_back(plane({0, 0, 0}, {0.05, 1, 0.03}, 0.5));  // slightly tilted: it folds one way
+    settings.selfCollision = {selfCollision, 0.02, 0.2, 0.5};
+    World world(settings);
+    EXPECT_EQ(world.hasStage(Stage::selfCollide), selfCollision);
+    EXPECT_EQ(world.run(180), StepStatus::ok);
+    Heap result{closestNonNeighbours(world.cloths()[0], 0.1), 0};
+    for (const Vec3& x : world.cloths()[0].state.position) {
+      result.stacked += -world.colliders()[0].distance(x, 10.0).distance < -(cloth.thickness + 0.01);
+    }
+    return result;
+  };
+  const Heap layered = heap(true);
+  EXPECT_GT(layered.closest, 0.5 * 0.02);  // no two layers closer than half the self-collision distance
+  EXPECT_GT(layered.stacked, 20);          // a real heap: many particles lie on other layers
+}
+
+TEST(SelfCollision, AClothDroppedOnAnotherLiesOnTopOfIt) {
+  const auto drop = [](bool selfCollision) {
+    WorldSettings settings;
+    settings.solver.substeps = 8;
+    settings.solver.iterations = 5;
+    settings.air.drag = 1.0;
+    ClothSettings below;
+    below.lattice = {16, 16, 0.6, 0.6, Vec3{-0.3, 0.006, -0.3}, LatticePlane::xz};
+    ClothSettings above = below;
+    above.lattice = {12, 12, 0.4, 0.4, Vec3{-0.2, 0.3, -0.2}, LatticePlane::xz};
+    settings.cloths = {below, above};
+    settings.colliders.push_back(plane({0, 0, 0}, {0, 1, 0}, 0.5));
+    // Particles are points: the distance must be about the particle spacing (0.04 m), or particles
+    // of one cloth slip through the gaps between those of the other.
+    settings.selfCollision = {selfCollision, 0.045, 0.3, 0.5};
+    World world(settings);
+    EXPECT_EQ(world.run(120), StepStatus::ok);
+    Real lowest = 1.0;
+    for (const Vec3& x : world.cloths()[1].state.position) lowest = std::min(lowest, x.y);
+    return lowest;
+  };
+  const Real thickness = ClothSettings{}.thickness;
+  EXPECT_GT(drop(true), thickness + 0.5 * 0.045);  // resting on the lower cloth
+  EXPECT_LT(drop(false), thickness + 0.002);       // without self-collision it falls through to the table
+}
+
+TEST(Pipeline, NothingToCollideWithMeansNoCollisionStages) {
+  World bare(test::hangingSheet(8, 10, 1));
+  for (Stage stage : {Stage::collide, Stage::friction, Stage::selfCollide, Stage::clampTravel, Stage::collideForces}) {
+    EXPECT_FALSE(bare.hasStage(stage));
+  }
+  WorldSettings settings = test::hangingSheet(8, 10, 1);
+  settings.colliders.push_back(plane({0, 0, 0}, {0, 1, 0}, 0.5));
+  World colliding(settings);
+  EXPECT_TRUE(colliding.hasStage(Stage::collide));
+  EXPECT_TRUE(colliding.hasStage(Stage::friction));
+}
+
+TEST(ForceModel, SpringClothRestsOnTheTableToo) {
+  WorldSettings settings = sheetAbove(10, 0.3, 0.5);
+  settings.solver = {Model::force, Integrator::symplecticEuler, 0.001, 1, 0, 0.0};
+  for (ConstraintKind kind : kConstraintKinds) settings.cloths[0].material(kind) = {500.0, 0.5};
+  settings.colliders.push_back(plane({0, 0, 0}, {0, 1, 0}, 0.5));
+  World world(settings);
+  EXPECT_TRUE(world.hasStage(Stage::collideForces));
+  ASSERT_EQ(world.run(2000), StepStatus::ok);
+  EXPECT_LT(deepestPenetration(world), 1e-3);
+  for (const Vec3& x : world.cloths()[0].state.position) EXPECT_LT(x.y, 0.05);  // it came down and stays down
+}
+
+}  // namespace
+}  // namespace drape::sim
