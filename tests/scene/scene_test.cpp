@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include <glm/geometric.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include "drape/scene/error.hpp"
@@ -39,7 +41,78 @@ TEST(ShippedScenes, RunTheirWholeDurationWithoutDivergingOrTearingApart) {
     ASSERT_EQ(world.run(steps), sim::StepStatus::ok);
     // No structural edge ends more than a quarter longer than its rest length.
     EXPECT_LT(sim::structuralStrain(world).max, 0.25);
+    // Nothing ends inside a collider deeper than a millimetre.
+    for (const sim::Cloth& cloth : world.cloths()) {
+      for (const sim::Vec3& x : cloth.state.position) {
+        for (const sim::Collider& collider : world.colliders()) EXPECT_GT(collider.distance(x, 1.0).distance, -1e-3);
+      }
+    }
   }
+}
+
+sim::World settle(const std::string& name, const std::vector<std::string>& overrides = {}) {
+  const Scene scene = loadScene(resolveScenePath(name), overrides);
+  sim::World world(scene.world);
+  EXPECT_EQ(world.run(static_cast<std::int64_t>(std::ceil(scene.duration / scene.world.solver.dt))),
+            sim::StepStatus::ok);
+  return world;
+}
+
+TEST(ShippedScenes, SlopeHoldsItsClothBelowTheFrictionAngleAndNotAbove) {
+  // How far the cloth's centre moves downhill (-x on this slope) between 1.5 s, when it has landed,
+  // and 3 s.
+  const auto creep = [](const std::vector<std::string>& overrides) {
+    std::vector<std::string> landed = overrides, later = overrides;
+    landed.push_back("duration=1.5");
+    later.push_back("duration=3");
+    const sim::World a = settle("slope", landed), b = settle("slope", later);
+    const sim::ParticleIndex centre = a.cloths()[0].rest.index(8, 8);
+    return a.cloths()[0].state.position[centre].x - b.cloths()[0].state.position[centre].x;
+  };
+  EXPECT_LT(std::abs(creep({})), 1e-3);  // tan(20 deg) = 0.36 < mu = 0.5: it stays put
+  EXPECT_GT(creep({"colliders.0.friction={\"static\":0.2,\"kinetic\":0.2}"}), 0.3);  // mu = 0.2: it slides
+}
+
+// The fold scene holds a cloth along row 16; rows 0-13 are the half that topples over, 18-31 the
+// half that hangs. Returns the closest distance between the two halves and the upper half's top.
+struct Fold {
+  double closest;
+  double upperTop;
+};
+
+Fold measureFold(const sim::World& world) {
+  const sim::Cloth& cloth = world.cloths()[0];
+  Fold fold{1.0, -1.0};
+  for (int r = 0; r <= 13; ++r) {
+    for (int c = 0; c < cloth.rest.columns; ++c) {
+      const sim::Vec3 a = cloth.state.position[cloth.rest.index(c, r)];
+      fold.upperTop = std::max(fold.upperTop, a.y);
+      for (int r2 = 18; r2 < cloth.rest.rows; ++r2) {
+        for (int c2 = 0; c2 < cloth.rest.columns; ++c2) {
+          fold.closest = std::min(fold.closest, glm::length(a - cloth.state.position[cloth.rest.index(c2, r2)]));
+        }
+      }
+    }
+  }
+  return fold;
+}
+
+TEST(ShippedScenes, FoldSettlesInTwoLayersThatDoNotPassThroughEachOther) {
+  const sim::World world = settle("fold");
+  const double distance = world.settings().selfCollision.distance;
+  const double heldAt = world.cloths()[0].state.position[world.cloths()[0].rest.index(0, 16)].y;
+  const Fold folded = measureFold(world);
+  EXPECT_LT(folded.upperTop, heldAt);         // the upper half has toppled over the held line
+  EXPECT_GT(folded.closest, 0.5 * distance);  // and lies against the lower half, not in it
+  EXPECT_LT(folded.closest, 0.15);            // side by side: the fold loop keeps them ~9 cm apart
+}
+
+TEST(ShippedScenes, ARisingBallLiftsTheCloth) {
+  const sim::World world = settle("rising-sphere");
+  double highest = 0.0;
+  for (const sim::Vec3& x : world.cloths()[0].state.position) highest = std::max(highest, x.y);
+  // The ball's top is at -0.3 + 0.3 + 0.25 * 4 = 1.0 m after 4 s; the cloth rides on it.
+  EXPECT_NEAR(highest, 1.0 + world.cloths()[0].settings.thickness, 0.02);
 }
 
 TEST(ShippedScenes, ResolveByName) {

@@ -76,7 +76,8 @@ void appendColliderGeometry(const sim::Collider& collider, ColliderGeometry& out
     case sim::ColliderShape::plane: {
       const sim::Vec3 n = glm::normalize(s.normal);
       const sim::Vec3 worldNormal = collider.orientation() * n;
-      if (worldNormal.y > 0.999 && std::abs(collider.centre().y) < 1e-9) return;  // the table
+      // A plane through the origin within ~8 degrees of level is shown by the table itself.
+      if (worldNormal.y > 0.99 && std::abs(collider.centre().y) < 1e-6) return;
       sim::Vec3 u, v;
       basis(n, u, v);
       quad(frame, sim::Vec3{0.0}, n, u * 1.5, v * 1.5, out);

@@ -21,8 +21,8 @@ struct ColliderGeometry {
   }
 };
 
-// Appends the collider's surface. The table plane (y = 0, facing up) is left out: the renderer
-// draws the table itself.
+// Appends the collider's surface. A plane through the origin facing (nearly) up is left out: the
+// renderer draws the table itself.
 void appendColliderGeometry(const sim::Collider& collider, ColliderGeometry& out);
 
 }  // namespace drape::render

@@ -151,7 +151,7 @@ void clampTravel(Cloth& cloth, Real maxTravel) {
   for (std::size_t i = 0; i < s.position.size(); ++i) {
     const Vec3 travel = s.position[i] - s.previousPosition[i];
     const Real length = glm::length(travel);
-    if (length > maxTravel) s.position[i] = s.previousPosition[i] + travel * (maxTravel / length);
+    if (length > maxTravel) s.previousPosition[i] = s.position[i] - travel * (maxTravel / length);
   }
 }
 

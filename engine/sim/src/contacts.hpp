@@ -29,6 +29,9 @@ void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders,
 
 // Self-collision: no particle within `distance` of another (or of their rest distance, if that is
 // smaller), found with a spatial hash; their relative tangential motion damped by `friction`.
+// clampTravel runs at the end of a substep and caps the velocity carried into the next one (by
+// moving x_prev, not x, so it never undoes what the constraints just did): no particle then
+// travels more than maxTravel in a substep on its own momentum, too little to pass through a layer.
 void clampTravel(Cloth& cloth, Real maxTravel);
 // Works across all cloths of the world, so two cloths collide with each other too.
 void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch);

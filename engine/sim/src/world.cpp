@@ -157,11 +157,13 @@ World::World(WorldSettings settings) : settings_(std::move(settings)), topologyV
   if (model == Model::position) {
     if (settings_.air.pressure > 0.0 && anyTriangles) add(Stage::windPressure, true);
     add(Stage::verletIntegrate, true);
-    if (selfCollision) add(Stage::clampTravel, true);
+    // Self-collision before the sweeps: its pushes are then reconciled with the constraints
+    // (after them, a push in a dense pile could stretch an edge by up to the collision distance).
+    if (selfCollision) add(Stage::selfCollide, true);
     if (anyColliders) add(Stage::collide, true);
     if (anyProjected && settings_.solver.iterations > 0) add(Stage::projectConstraints, true);
     if (anyColliders) add(Stage::friction, true);
-    if (selfCollision) add(Stage::selfCollide, true);
+    if (selfCollision) add(Stage::clampTravel, true);
     if (anyDamped) add(Stage::dampConstraints, true);
   } else {
     add(integratorStage(settings_.solver.integrator), true);

@@ -17,7 +17,7 @@ enum class Stage : std::uint8_t {
   verletIntegrate,     // x' = x + (x - x_prev) decay + a h^2
   projectConstraints,  // Gauss-Seidel sweeps over stretch, shear, bend constraints
   dampConstraints,     // remove a fraction of relative velocity along each damped constraint
-  clampTravel,         // self-collision: no particle moves more than a fraction of the distance
+  clampTravel,         // self-collision: cap the velocity carried into the next substep
   collide,             // find contact planes along each particle's motion; project onto them
   friction,            // Coulomb friction against colliders, after the sweeps
   selfCollide,         // push apart particles of a cloth that come too close
