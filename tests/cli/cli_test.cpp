@@ -74,7 +74,7 @@ void expectOneLineError(const Result& result, int exitCode, const std::string& f
 }
 
 TEST_F(Cli, ValidatesTheShippedScenes) {
-  for (const char* name : {"hang", "trampoline", "chain", "curtain", "hang-springs", "spring"}) {
+  for (const char* name : {"hang", "trampoline", "chain", "curtain", "hang-springs", "spring", "drape-sphere", "dome"}) {
     const Result result = run(std::string("validate ") + name);
     EXPECT_EQ(result.exitCode, 0) << name << ": " << result.err;
     EXPECT_NE(result.out.find(": ok: "), std::string::npos) << result.out;
@@ -219,6 +219,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"DuplicateKey", R"({"solver": {"dt": 0.01, "dt": 0.5}})", "", "bad.json: key \"dt\" appears twice"},
         BadInput{"KeyWithNewline", "{\"a\\nb\": 1}", "", "bad.json: a?b: unknown key"},
         BadInput{"TinyMass", nullptr, "--set cloths.0.mass=1e-310", "cloths.0.mass: expected a number >= 1e-06"},
+        BadInput{"ZeroRadius", R"({"colliders": [{"type": "sphere", "radius": 0}]})", "",
+                 "bad.json: colliders.0.radius: expected a number > 0 and <= 1000 (m), got 0"},
+        BadInput{"ZeroNormal", R"({"colliders": [{"type": "plane", "normal": [0, 0, 0]}]})", "",
+                 "bad.json: colliders.0.normal: expected a non-zero vector, got [0,0,0]"},
+        BadInput{"NegativeFriction", R"({"colliders": [{"type": "box", "friction": {"static": -0.1}}]})", "",
+                 "bad.json: colliders.0.friction.static: expected a number >= 0 and <= 10, got -0.1"},
+        BadInput{"UnknownShape", R"({"colliders": [{"type": "cone"}]})", "", "bad.json: colliders.0.type: expected one of"},
+        BadInput{"MissingObj", R"({"colliders": [{"type": "mesh", "file": "missing.obj"}]})", "",
+                 "bad.json: colliders.0.file: cannot use the OBJ file"},
         BadInput{"SameOutputTwice", nullptr, "--out s2.json --out ./s2.json", "s2.json: named as an output twice"},
         BadInput{"InvalidUtf8", nullptr, "--set \"solver.model=$(printf '\\377')\"", "solver.model: expected one of"}),
     [](const auto& testInfo) { return std::string(testInfo.param.name); });
@@ -259,6 +268,17 @@ TEST_F(Cli, RenderRefusesBadValuesWithOneLine) {
   expectOneLineError(run("render hang --out /nonexistent-dir/x.png"), 2, "/nonexistent-dir/x.png: cannot write");
   expectOneLineError(run("render hang"), 2, "say where the pictures go");
   EXPECT_FALSE(fs::exists(file("x.png")));
+}
+
+TEST_F(Cli, MalformedObjFilesAreBadInput) {
+  const std::string scene = R"({"colliders": [{"type": "mesh", "file": "shape.obj"}], "cloths": []})";
+  const fs::path sceneFile = write("mesh.json", scene);
+  write("shape.obj", "this is not an obj file\n");
+  expectOneLineError(run("validate '" + sceneFile.string() + "'"), 2, "colliders.0.file: cannot use the OBJ file");
+  write("shape.obj", "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 9\n");
+  expectOneLineError(run("validate '" + sceneFile.string() + "'"), 2, "a face refers to a vertex it does not have");
+  write("shape.obj", "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n");
+  EXPECT_EQ(run("validate '" + sceneFile.string() + "'").exitCode, 0);
 }
 
 TEST_F(Cli, AStepCountPastTheLimitIsBadInput) {

@@ -39,8 +39,8 @@ std::shared_ptr<const sim::TriangleMesh> loadObj(ObjectReader& reader, const std
         const int a = indices[i].vertex_index, b = indices[i + 1].vertex_index, c = indices[i + 2].vertex_index;
         const auto count = static_cast<int>(mesh->vertices.size());
         if (a < 0 || b < 0 || c < 0 || a >= count || b >= count || c >= count) {
-          reader.fail("file", "an OBJ whose faces index its vertices (" + path.string() + " has one that does not)",
-                      nullptr);
+          throw InputError(reader.source() + ": " + reader.pathOf("file") + ": cannot use the OBJ file " +
+                           path.string() + ": a face refers to a vertex it does not have");
         }
         mesh->triangles.push_back({a, b, c});
       }
