@@ -74,7 +74,8 @@ void expectOneLineError(const Result& result, int exitCode, const std::string& f
 }
 
 TEST_F(Cli, ValidatesTheShippedScenes) {
-  for (const char* name : {"hang", "trampoline", "chain", "curtain", "hang-springs", "spring", "drape-sphere", "dome"}) {
+  for (const char* name :
+       {"hang", "trampoline", "chain", "curtain", "hang-springs", "spring", "drape-sphere", "dome"}) {
     const Result result = run(std::string("validate ") + name);
     EXPECT_EQ(result.exitCode, 0) << name << ": " << result.err;
     EXPECT_NE(result.out.find(": ok: "), std::string::npos) << result.out;
@@ -225,7 +226,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "bad.json: colliders.0.normal: expected a non-zero vector, got [0,0,0]"},
         BadInput{"NegativeFriction", R"({"colliders": [{"type": "box", "friction": {"static": -0.1}}]})", "",
                  "bad.json: colliders.0.friction.static: expected a number >= 0 and <= 10, got -0.1"},
-        BadInput{"UnknownShape", R"({"colliders": [{"type": "cone"}]})", "", "bad.json: colliders.0.type: expected one of"},
+        BadInput{"UnknownShape", R"({"colliders": [{"type": "cone"}]})", "",
+                 "bad.json: colliders.0.type: expected one of"},
         BadInput{"MissingObj", R"({"colliders": [{"type": "mesh", "file": "missing.obj"}]})", "",
                  "bad.json: colliders.0.file: cannot use the OBJ file"},
         BadInput{"SameOutputTwice", nullptr, "--out s2.json --out ./s2.json", "s2.json: named as an output twice"},

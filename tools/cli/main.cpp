@@ -5,27 +5,37 @@
 
 #include "commands.hpp"
 
+namespace {
+
+using namespace drape::cli;
+
+void addSceneOptions(CLI::App* command, SceneArguments& arguments) {
+  command->add_option("scene", arguments.scene, "Scene file, or the name of a shipped scene")->required();
+  command->add_option("--set", arguments.overrides, "Override a key: path=value (repeatable)");
+}
+
+void addLengthOptions(CLI::App* command, std::optional<std::int64_t>& steps, std::optional<double>& seconds) {
+  CLI::Option* stepsOption = command->add_option("--steps", steps, "Number of steps (default: the scene's duration)")
+                                 ->check(CLI::Range(std::int64_t{0}, std::int64_t{1000000000}));
+  command->add_option("--time", seconds, "Simulated seconds instead of --steps")
+      ->check(CLI::Range(0.0, 1.0e6))
+      ->excludes(stepsOption);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace drape::cli;
   CLI::App app{"drape-cli: the Drape cloth engine, headless"};
   app.require_subcommand(1);
 
   SceneArguments validateArguments;
   CLI::App* validateCommand = app.add_subcommand("validate", "Check a scene file; exit 0 if it is valid, 2 if not");
-  validateCommand->add_option("scene", validateArguments.scene, "Scene file, or the name of a shipped scene")
-      ->required();
-  validateCommand->add_option("--set", validateArguments.overrides, "Override a key: path=value (repeatable)");
+  addSceneOptions(validateCommand, validateArguments);
 
   RunArguments runArguments;
   CLI::App* runCommand = app.add_subcommand("run", "Simulate a scene and write its final state, mesh or a trace");
-  runCommand->add_option("scene", runArguments.input.scene, "Scene file, or the name of a shipped scene")->required();
-  runCommand->add_option("--set", runArguments.input.overrides, "Override a key: path=value (repeatable)");
-  CLI::Option* steps =
-      runCommand->add_option("--steps", runArguments.steps, "Number of steps (default: the scene's duration)")
-          ->check(CLI::Range(std::int64_t{0}, std::int64_t{1000000000}));
-  runCommand->add_option("--time", runArguments.seconds, "Simulated seconds instead of --steps")
-      ->check(CLI::Range(0.0, 1.0e6))
-      ->excludes(steps);
+  addSceneOptions(runCommand, runArguments.input);
+  addLengthOptions(runCommand, runArguments.steps, runArguments.seconds);
   runCommand->add_option("--out", runArguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
   CLI::Option* trace = runCommand->add_option("--trace", runArguments.trace, "Trace one particle: column,row");
   runCommand->add_option("--trace-cloth", runArguments.traceCloth, "Which cloth --trace refers to (default 0)")
@@ -40,15 +50,8 @@ int main(int argc, char** argv) {
   RenderArguments renderArguments;
   CLI::App* renderCommand =
       app.add_subcommand("render", "Simulate a scene and draw it off-screen (OSMesa) to PNG pictures");
-  renderCommand->add_option("scene", renderArguments.input.scene, "Scene file, or the name of a shipped scene")
-      ->required();
-  renderCommand->add_option("--set", renderArguments.input.overrides, "Override a key: path=value (repeatable)");
-  CLI::Option* renderSteps =
-      renderCommand->add_option("--steps", renderArguments.steps, "Steps to simulate (default: the scene's duration)")
-          ->check(CLI::Range(std::int64_t{0}, std::int64_t{1000000000}));
-  renderCommand->add_option("--time", renderArguments.seconds, "Simulated seconds instead of --steps")
-      ->check(CLI::Range(0.0, 1.0e6))
-      ->excludes(renderSteps);
+  addSceneOptions(renderCommand, renderArguments.input);
+  addLengthOptions(renderCommand, renderArguments.steps, renderArguments.seconds);
   renderCommand->add_option("--size", renderArguments.size, "Picture size WxH in pixels (default 800x600)");
   renderCommand->add_option("--camera", renderArguments.camera,
                             "auto, front, side, top, or yaw,pitch,distance[,x,y,z] in degrees and metres");

@@ -3,10 +3,10 @@
 //
 // What it draws: each cloth as a smooth two-sided lit surface (normals recomputed every frame, a
 // front and a back colour, optionally a strain colour map); a chain as links and beads; the table
-// (y = 0) with a soft shadow of the cloth; colliders as grey solids; pins as round markers; and an overlay of finger rings
-// and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry.
-// Positions and normals stream every frame into buffers allocated once; index buffers are
-// re-uploaded only when the world's topology version changes.
+// (y = 0) with a soft shadow of the cloth; colliders as grey solids; pins as round markers; and an overlay of finger
+// rings and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry. Positions and
+// normals stream every frame into buffers allocated once; index buffers are re-uploaded only when the world's topology
+// version changes.
 #pragma once
 
 #include <cstdint>
