@@ -156,15 +156,53 @@ TEST(Friction, AboveTheFrictionAngleItSlidesAsCoulombSays) {
   EXPECT_NEAR(slideAlongSlope(theta, 0.0, t), frictionless, 0.01 * frictionless);
 }
 
-TEST(Tunnelling, AFastDropDoesNotPassThroughAThinBox) {
+struct FastDrop {
+  double height;     // m, where the sheet starts
+  double thickness;  // m, of the cloth
+};
+
+class Tunnelling : public ::testing::TestWithParam<FastDrop> {};
+
+TEST_P(Tunnelling, AFastDropEndsOnTopOfAThinBoxNotInOrUnderIt) {
   // 50 m/s at 60 Hz moves 0.83 m a step; the board is 1 cm thick.
-  WorldSettings settings = sheetAbove(12, 0.5, 0.6);
+  WorldSettings settings = sheetAbove(12, GetParam().height, 0.6);
   settings.solver.substeps = 1;
   settings.cloths[0].initialVelocity = {0, -50, 0};
+  settings.cloths[0].thickness = GetParam().thickness;
   settings.colliders.push_back(box({0, 0, 0}, {1, 0.005, 1}));
   World world(settings);
   ASSERT_EQ(world.run(60), StepStatus::ok);
-  for (const Vec3& x : world.cloths()[0].state.position) EXPECT_GT(x.y, 0.0);
+  for (const Vec3& x : world.cloths()[0].state.position) EXPECT_GE(x.y, 0.005 + GetParam().thickness - 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Drops, Tunnelling,
+                         ::testing::Values(FastDrop{0.5, 0.005}, FastDrop{0.6, 0.01}, FastDrop{0.7, 0.01},
+                                           FastDrop{0.55, 0.002}));
+
+TEST(MovingColliders, ARisingBoardLiftsTheClothInsteadOfPassingThroughIt) {
+  // 3 m/s at 2 substeps of 1/120 s: the 1 cm board moves 2.5 cm a substep, farther than it is thick.
+  WorldSettings settings = sheetAbove(10, 0.3, 0.4);
+  settings.gravity = Vec3{0.0};
+  settings.solver.substeps = 2;
+  ColliderSettings board = box({0, 0, 0}, {1, 0.005, 1});
+  board.velocity = {0, 3, 0};
+  settings.colliders.push_back(board);
+  World world(settings);
+  ASSERT_EQ(world.run(30), StepStatus::ok);  // 0.5 s: the board is at 1.5 m
+  for (const Vec3& x : world.cloths()[0].state.position) EXPECT_GE(x.y, 1.5 + 0.005 + 0.005 - 1e-6);
+}
+
+TEST(MovingColliders, ATurningBoxCarriesItsSurfaceRound) {
+  ColliderSettings s = box({1, 0, 0}, {0.5, 0.5, 2.0});
+  s.angularVelocity = {0, std::numbers::pi / 2, 0};  // a quarter turn a second about y
+  Collider turning(s);
+  turning.setTime(1.0);
+  // After a quarter turn the long (z) side lies along x: 2 m from the centre along x is the surface.
+  EXPECT_NEAR(turning.distance({3.0, 0, 0}, 10).distance, 0.0, 1e-9);
+  EXPECT_NEAR(turning.distance({1.0, 0, 0.5}, 10).distance, 0.0, 1e-9);
+  const Vec3 carried = turning.carried({1.0, 0.0, 1.0});  // a point 1 m in +z of the centre at t = 0...
+  turning.setTime(1.0);
+  EXPECT_NEAR(glm::length(carried - Vec3{2.0, 0.0, 0.0}), 0.0, 1e-9);  // ...is 1 m in +x a quarter turn on
 }
 
 TEST(Tunnelling, AFastDropDoesNotPassThroughAMeshShell) {

@@ -113,6 +113,20 @@ void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) 
       upper = glm::max(upper, x);
     }
   }
+  for (const sim::Collider& collider : world.colliders()) {
+    const sim::ColliderSettings& s = collider.settings();
+    // A bounding sphere of each finite shape (planes are endless; meshes use their vertices).
+    double radius = 0.0;
+    if (s.shape == sim::ColliderShape::sphere) radius = s.radius;
+    if (s.shape == sim::ColliderShape::capsule) radius = s.radius + glm::length(s.halfAxis);
+    if (s.shape == sim::ColliderShape::box) radius = glm::length(s.halfExtents);
+    if (s.shape == sim::ColliderShape::mesh) {
+      for (const sim::Vec3& v : s.mesh->vertices) radius = std::max(radius, glm::length(v));
+    }
+    if (radius == 0.0) continue;
+    lower = glm::min(lower, collider.centre() - radius);
+    upper = glm::max(upper, collider.centre() + radius);
+  }
   if (lower.x > upper.x) {  // nothing in the world: frame the table around the origin
     lower = glm::dvec3{-1.0, 0.0, -1.0};
     upper = glm::dvec3{1.0, 1.0, 1.0};

@@ -10,6 +10,8 @@ namespace drape::sim {
 
 Collider::Collider(ColliderSettings settings) : settings_(std::move(settings)) {
   if (settings_.shape == ColliderShape::plane) settings_.normal = glm::normalize(settings_.normal);
+  settings_.orientation = glm::normalize(settings_.orientation);  // conjugate must be the inverse
+  setTime(0.0);
   setTime(0.0);
   if (settings_.shape == ColliderShape::mesh) buildGrid();
 }
@@ -19,10 +21,16 @@ bool Collider::moving() const {
 }
 
 void Collider::setTime(Real t) {
+  previousCentre_ = centre_;
+  previousOrientation_ = orientation_;
   centre_ = settings_.position + settings_.velocity * t;
   const Real spin = glm::length(settings_.angularVelocity);
   orientation_ = spin > 0.0 ? glm::angleAxis(spin * t, settings_.angularVelocity / spin) * settings_.orientation
                             : settings_.orientation;
+}
+
+Vec3 Collider::carried(Vec3 p) const {
+  return centre_ + orientation_ * (glm::conjugate(previousOrientation_) * (p - previousCentre_));
 }
 
 Vec3 Collider::surfaceVelocity(Vec3 p) const {
@@ -92,14 +100,15 @@ SurfaceDistance Collider::local(Vec3 p, Real reach) const {
     case ColliderShape::mesh: {
       SurfaceDistance best{reach, Vec3{0.0, 1.0, 0.0}};
       if (gridCells_.x == 0) return best;
+      if (!std::isfinite(p.x + p.y + p.z) ||
+          glm::any(glm::greaterThan(
+              glm::abs(p - glm::clamp(p, gridOrigin_, gridOrigin_ + Vec3(gridCells_) * cellSize_)), Vec3{reach}))) {
+        return best;  // the whole mesh is out of reach (tested before any conversion to int)
+      }
       const glm::ivec3 lower =
           glm::clamp(glm::ivec3(glm::floor((p - reach - gridOrigin_) / cellSize_)), glm::ivec3(0), gridCells_ - 1);
       const glm::ivec3 upper =
           glm::clamp(glm::ivec3(glm::floor((p + reach - gridOrigin_) / cellSize_)), glm::ivec3(0), gridCells_ - 1);
-      if (glm::any(glm::greaterThan(
-              glm::abs(p - glm::clamp(p, gridOrigin_, gridOrigin_ + Vec3(gridCells_) * cellSize_)), Vec3{reach}))) {
-        return best;  // the whole mesh is out of reach
-      }
       const TriangleMesh& mesh = *s.mesh;
       for (int z = lower.z; z <= upper.z; ++z) {
         for (int y = lower.y; y <= upper.y; ++y) {

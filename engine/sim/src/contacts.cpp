@@ -1,6 +1,7 @@
 #include "contacts.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -16,38 +17,39 @@ struct Candidate {
 };
 
 // The contact plane, if the motion from `from` to `to` comes within `thickness` of the collider.
-Candidate touch(const Collider& collider, int index, Vec3 from, Vec3 to, Real thickness) {
+Candidate touch(const Collider& collider, int index, Vec3 previous, Vec3 to, Real thickness) {
+  const Vec3 from = collider.carried(previous);  // in the collider's frame, the particle came from here
   const Vec3 motion = to - from;
   const Real travel = glm::length(motion);
   const Real reach = travel + 2.0 * thickness + 1e-6;
   const SurfaceDistance start = collider.distance(from, reach);
   if (start.distance >= reach) return {};
+  const auto planeThrough = [&](Vec3 p, const SurfaceDistance& d) {
+    return Candidate{index, d.normal, glm::dot(d.normal, p - d.normal * d.distance) + thickness};
+  };
   if (start.distance < thickness) {
-    // Already touching (resting contact, or a rounding-deep start): the surface nearest the end,
-    // seen from the side the particle started on.
+    // Already touching (resting contact): keep to the side it started on. The surface nearest the
+    // end serves while it faces the same way; past the middle of a thin solid it would be the far
+    // face, and would push the particle out underneath.
     const SurfaceDistance end = collider.distance(to, reach);
-    if (collider.settings().shape == ColliderShape::mesh) {
-      const Vec3 surface = from - start.normal * start.distance;
-      return {index, start.normal, glm::dot(start.normal, surface) + thickness};
+    if (collider.settings().shape != ColliderShape::mesh && end.distance < thickness &&
+        glm::dot(end.normal, start.normal) > 0.0) {
+      return planeThrough(to, end);
     }
-    return {index, end.normal, glm::dot(end.normal, to) - end.distance + thickness};
+    return planeThrough(from, start);
   }
   // Sphere tracing: the distance bounds how far the segment can advance without meeting the surface.
   Real t = 0.0;
   SurfaceDistance here = start;
-  for (int step = 0; step < 64 && travel > 0.0; ++step) {
-    if (here.distance < thickness) {
-      const Vec3 p = from + motion * t;
-      const Vec3 surface = p - here.normal * here.distance;
-      return {index, here.normal, glm::dot(here.normal, surface) + thickness};
-    }
-    t += std::max(here.distance - thickness * 0.5, thickness * 0.25) / travel;
+  while (travel > 0.0) {
+    if (here.distance < thickness) return planeThrough(from + motion * t, here);
+    t += std::max(std::max(here.distance - thickness * 0.5, thickness * 0.25) / travel, 1.0 / 256.0);
     if (t > 1.0) break;
     here = collider.distance(from + motion * t, reach);
   }
   // The end point itself (the march may step past a surface it only grazes at the end).
   const SurfaceDistance end = collider.distance(to, reach);
-  if (end.distance < thickness) return {index, end.normal, glm::dot(end.normal, to) - end.distance + thickness};
+  if (end.distance < thickness) return planeThrough(to, end);
   return {};
 }
 
@@ -126,6 +128,7 @@ void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders,
     if (c < 0) continue;
     const Collider& collider = colliders[static_cast<std::size_t>(c)];
     const Vec3 n = scratch.contactNormal[i];
+    if (glm::dot(n, s.position[i]) - scratch.contactOffset[i] > 1e-9) continue;  // passing by, not touching
     const Vec3 surface = collider.surfaceVelocity(s.position[i]);
     Vec3 relative = s.velocity[i] - surface;
     const Real approach = glm::dot(relative, n);
@@ -168,11 +171,13 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
   const std::size_t n = scratch.owner.size();
   const Real d = settings.distance;
   const std::size_t tableSize = 2 * n + 1;
-  const auto hashOf = [tableSize](glm::i64vec3 cell) {
-    const auto h = static_cast<std::uint64_t>((cell.x * 92837111) ^ (cell.y * 689287499) ^ (cell.z * 283923481));
+  // Wrapping unsigned arithmetic: no overflow whatever the cell. Positions are finite and within
+  // 1e6 m (the guard), and clamped so the cell always fits.
+  const auto hashOf = [tableSize](glm::u64vec3 cell) {
+    const std::uint64_t h = (cell.x * 92837111u) ^ (cell.y * 689287499u) ^ (cell.z * 283923481u);
     return static_cast<std::size_t>(h % tableSize);
   };
-  const auto cellOf = [d](Vec3 x) { return glm::i64vec3(glm::floor(x / d)); };
+  const auto cellOf = [d](Vec3 x) { return glm::u64vec3(glm::i64vec3(glm::floor(glm::clamp(x, -2.0e6, 2.0e6) / d))); };
   const auto positionOf = [&cloths](const SelfCollisionScratch::Owner& o) -> Vec3& {
     return cloths[o.cloth].state.position[o.particle];
   };
@@ -186,40 +191,46 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
   }
 
   const Real d2 = d * d;
+  std::array<std::size_t, 27> buckets{};
   for (std::size_t a = 0; a < n; ++a) {
     const auto [ca, i] = scratch.owner[a];
     ParticleState& si = cloths[ca].state;
-    const glm::i64vec3 cell = cellOf(si.position[i]);
+    // The buckets of the 27 cells around the particle, each once: two cells may share a bucket.
+    const glm::u64vec3 cell = cellOf(si.position[i]);
+    std::size_t count = 0;
     for (int z = -1; z <= 1; ++z) {
       for (int y = -1; y <= 1; ++y) {
-        for (int x = -1; x <= 1; ++x) {
-          const std::size_t bucket = hashOf(cell + glm::i64vec3(x, y, z));
-          for (std::uint32_t k = scratch.start[bucket]; k < scratch.start[bucket + 1]; ++k) {
-            const std::uint32_t b = scratch.entries[k];
-            if (b <= a) continue;
-            const auto [cb, j] = scratch.owner[b];
-            ParticleState& sj = cloths[cb].state;
-            const Vec3 between = sj.position[j] - si.position[i];
-            const Real distance2 = glm::dot(between, between);
-            if (distance2 >= d2 || distance2 < 1e-24) continue;
-            const Real wi = si.inverseMass[i], wj = sj.inverseMass[j];
-            if (wi + wj == 0.0) continue;
-            // Particles of one cloth closer than d at rest (neighbours) keep their rest distance.
-            const Real target =
-                ca == cb ? std::min(d, glm::length(cloths[ca].rest.restPositions[j] - cloths[ca].rest.restPositions[i]))
-                         : d;
-            const Real distance = std::sqrt(distance2);
-            if (distance >= target) continue;
-            const Vec3 push = between * ((target - distance) / (distance * (wi + wj)));
-            si.position[i] -= push * wi;
-            sj.position[j] += push * wj;
-            // Cloth-cloth friction: move both velocities towards their mean.
-            const Vec3 vi = si.position[i] - si.previousPosition[i], vj = sj.position[j] - sj.previousPosition[j];
-            const Vec3 mean = (vi + vj) * 0.5;
-            si.previousPosition[i] += (vi - mean) * settings.friction;
-            sj.previousPosition[j] += (vj - mean) * settings.friction;
-          }
-        }
+        for (int x = -1; x <= 1; ++x) buckets[count++] = hashOf(cell + glm::u64vec3(glm::i64vec3(x, y, z)));
+      }
+    }
+    std::sort(buckets.begin(), buckets.end());
+    const auto last = std::unique(buckets.begin(), buckets.end());
+    for (auto bucket = buckets.begin(); bucket != last; ++bucket) {
+      for (std::uint32_t k = scratch.start[*bucket]; k < scratch.start[*bucket + 1]; ++k) {
+        const std::uint32_t b = scratch.entries[k];
+        if (b <= a) continue;
+        const auto [cb, j] = scratch.owner[b];
+        ParticleState& sj = cloths[cb].state;
+        const Vec3 between = sj.position[j] - si.position[i];
+        const Real distance2 = glm::dot(between, between);
+        if (distance2 >= d2 || distance2 < 1e-24) continue;
+        const Real wi = si.inverseMass[i], wj = sj.inverseMass[j];
+        if (wi + wj == 0.0) continue;
+        // Particles of one cloth closer than d at rest (neighbours) keep their rest distance.
+        const Real target =
+            ca == cb ? std::min(d, glm::length(cloths[ca].rest.restPositions[j] - cloths[ca].rest.restPositions[i]))
+                     : d;
+        const Real distance = std::sqrt(distance2);
+        if (distance >= target) continue;
+        const Vec3 push = between * ((target - distance) / (distance * (wi + wj)));
+        si.position[i] -= push * wi;
+        sj.position[j] += push * wj;
+        // Cloth-cloth friction: remove `friction` of the pair's relative velocity, shared by inverse
+        // mass (momentum is kept; a pinned particle takes none).
+        const Vec3 relative = (si.position[i] - si.previousPosition[i]) - (sj.position[j] - sj.previousPosition[j]);
+        const Vec3 change = relative * (settings.friction / (wi + wj));
+        si.previousPosition[i] += change * wi;
+        sj.previousPosition[j] -= change * wj;
       }
     }
   }

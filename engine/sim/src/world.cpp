@@ -290,6 +290,7 @@ StepStatus World::step() {
 
   if (divergence_) {
     for (std::size_t c = 0; c < cloths_.size(); ++c) cloths_[c].state = lastGood_[c];
+    for (Collider& collider : colliders_) collider.setTime(time());  // back where the good state saw them
     return StepStatus::diverged;
   }
   ++stepCount_;

@@ -80,7 +80,7 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-// The box around every particle of the world (and the table at y = 0 under it).
+// The box around every particle and finite collider of the world (and the table at y = 0 under it).
 void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper);
 
 }  // namespace drape::render

@@ -58,8 +58,13 @@ class Collider {
   explicit Collider(ColliderSettings settings);
 
   const ColliderSettings& settings() const { return settings_; }
-  // Moves the collider to where its motion puts it at time t.
+  // Moves the collider to where its motion puts it at time t; the pose it had is kept as the
+  // previous one (the start of the substep).
   void setTime(Real t);
+  // Where a point that was at p, carried along with the collider from its previous pose to its
+  // current one, is now: contacts sweep x_prev carried this way to x, so a moving collider cannot
+  // jump past a particle between two substeps.
+  Vec3 carried(Vec3 p) const;
   bool moving() const;
   Vec3 centre() const { return centre_; }                  // m, where the position is now
   glm::dquat orientation() const { return orientation_; }  // of its frame now
@@ -76,6 +81,8 @@ class Collider {
   ColliderSettings settings_;
   Vec3 centre_;
   glm::dquat orientation_;
+  Vec3 previousCentre_;
+  glm::dquat previousOrientation_;
   // Mesh grid: triangles per cell, cells of `cellSize_` from `gridOrigin_`.
   Vec3 gridOrigin_{0.0};
   Real cellSize_ = 1.0;
