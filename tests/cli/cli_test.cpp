@@ -283,6 +283,16 @@ TEST_F(Cli, MalformedObjFilesAreBadInput) {
   EXPECT_EQ(run("validate '" + sceneFile.string() + "'").exitCode, 0);
 }
 
+TEST_F(Cli, StabilityWritesItsMapPictureAndReport) {
+  const fs::path folder = file("stability"), report = file("stability.md");
+  const Result result = run("stability --quiet --out-dir '" + folder.string() + "' --report '" + report.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  for (const char* name : {"stability.csv", "boundaries.csv", "stability.png"}) EXPECT_TRUE(fs::exists(folder / name));
+  const std::string text = read(report);
+  EXPECT_NE(text.find("| verlet | 1e+04 |"), std::string::npos);
+  EXPECT_NE(text.find("never stable"), std::string::npos);
+}
+
 TEST_F(Cli, AStepCountPastTheLimitIsBadInput) {
   expectOneLineError(run("run hang --set duration=100000 --set solver.dt=1e-6"), 2,
                      "duration / solver.dt asks for 100000000000 steps, more than the limit of 1000000000");

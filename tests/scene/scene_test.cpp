@@ -238,3 +238,40 @@ TEST(SceneErrors, NonFiniteNumbersAreRefused) {
 
 }  // namespace
 }  // namespace drape::scene
+
+namespace drape::scene {
+namespace {
+
+// assets/extreme: stiff, huge steps, many iterations, hurricane, one particle, coincident particles,
+// heavy gravity. The position model must stay finite and bounded in every one; the force model may
+// diverge, but then the world must say so (at which step) and hold the last good, finite state.
+TEST(ExtremeScenes, PositionModelStaysFiniteAndBoundedForceModelReportsDivergence) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(sceneDirectory().parent_path() / "extreme")) {
+    SCOPED_TRACE(entry.path().string());
+    const Scene scene = loadScene(entry.path());
+    sim::World world(scene.world);
+    const sim::StepStatus status =
+        world.run(static_cast<std::int64_t>(std::ceil(scene.duration / scene.world.solver.dt)));
+    if (scene.world.solver.model == sim::Model::position) {
+      EXPECT_EQ(status, sim::StepStatus::ok);
+    } else {
+      EXPECT_EQ(status, sim::StepStatus::diverged);
+      ASSERT_TRUE(world.divergence().has_value());
+      EXPECT_GT(world.divergence()->step, 0);
+    }
+    for (const sim::Cloth& cloth : world.cloths()) {
+      for (const sim::Vec3& x : cloth.state.position) {
+        EXPECT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
+        if (scene.world.solver.model == sim::Model::position) {
+          EXPECT_LT(glm::length(x), 100.0);
+        }
+      }
+    }
+    ++count;
+  }
+  EXPECT_GE(count, 8);
+}
+
+}  // namespace
+}  // namespace drape::scene

@@ -45,7 +45,14 @@ struct RenderArguments {
   bool quiet = false;
 };
 
+struct StabilityArguments {
+  std::string outDir = "stability";   // CSV, gnuplot script and picture
+  std::optional<std::string> report;  // Markdown report
+  bool quiet = false;
+};
+
 int validate(const SceneArguments& arguments);
+int stability(const StabilityArguments& arguments);
 int render(const RenderArguments& arguments);
 int run(const RunArguments& arguments);
 int listScenes();

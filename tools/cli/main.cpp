@@ -65,6 +65,14 @@ int main(int argc, char** argv) {
   renderCommand->add_flag("--strain", renderArguments.strain, "Colour the cloth by its stretch");
   renderCommand->add_flag("--quiet", renderArguments.quiet, "Print nothing on success");
 
+  StabilityArguments stabilityArguments;
+  CLI::App* stabilityCommand = app.add_subcommand(
+      "stability", "Map where each force-model integrator is stable (stiffness x dt) against linear theory");
+  stabilityCommand->add_option("--out-dir", stabilityArguments.outDir,
+                               "Folder for CSV and picture (default stability)");
+  stabilityCommand->add_option("--report", stabilityArguments.report, "Also write a Markdown report here");
+  stabilityCommand->add_flag("--quiet", stabilityArguments.quiet, "Print nothing on success");
+
   app.add_subcommand("scenes", "List the shipped scenes");
 
   try {
@@ -78,6 +86,7 @@ int main(int argc, char** argv) {
     if (*validateCommand) return validate(validateArguments);
     if (*runCommand) return run(runArguments);
     if (*renderCommand) return render(renderArguments);
+    if (*stabilityCommand) return stability(stabilityArguments);
     return listScenes();
   } catch (const std::exception& error) {  // a bug, not bad input: say so rather than abort
     std::cerr << "drape-cli: internal error: " << error.what() << "\n";
