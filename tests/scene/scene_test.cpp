@@ -275,3 +275,28 @@ TEST(ExtremeScenes, PositionModelStaysFiniteAndBoundedForceModelReportsDivergenc
 
 }  // namespace
 }  // namespace drape::scene
+
+namespace drape::scene {
+namespace {
+
+TEST(SceneReader, XpbdTethersAndComplianceBelongToThePositionModel) {
+  json document = minimal();
+  applyOverride(document, "solver.xpbd=true");
+  applyOverride(document, "solver.tethers=true");
+  applyOverride(document, "cloths.0.stretch={\"compliance\":1e-6}");
+  const Scene scene = parseScene(document, "s.json");
+  EXPECT_TRUE(scene.world.solver.xpbd && scene.world.solver.tethers);
+  EXPECT_DOUBLE_EQ(scene.world.cloths[0].material(sim::ConstraintKind::stretch).compliance, 1e-6);
+  applyOverride(document, "solver.xpbd=false");
+  EXPECT_EQ(
+      errorOf([&] { parseScene(document, "s.json"); }),
+      "s.json: cloths.0.stretch.compliance: expected no compliance unless \"solver\": {\"xpbd\": true}, got 1e-06");
+  json force = minimal();
+  applyOverride(force, "solver.model=force");
+  applyOverride(force, "solver.tethers=true");
+  EXPECT_EQ(errorOf([&] { parseScene(force, "s.json"); }),
+            "s.json: solver.tethers: expected false for the force model (it belongs to the position model), got true");
+}
+
+}  // namespace
+}  // namespace drape::scene

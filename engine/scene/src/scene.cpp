@@ -43,7 +43,7 @@ KindMaterial defaultMaterial(Model model, ConstraintKind kind) {
   return {};
 }
 
-KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model) {
+KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model, bool xpbd) {
   KindMaterial material = defaultMaterial(model, kind);
   const std::string_view key = sim::name(kind);
   if (!cloth.has(key)) return material;
@@ -53,6 +53,10 @@ KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model)
         reader.number("stiffness", material.stiffness, {0.0, 1.0, false, "fraction corrected per sweep"});
     material.damping = reader.number("damping", material.damping,
                                      {0.0, 1.0, false, "fraction of relative velocity removed per substep"});
+    if (reader.has("compliance") && !xpbd) {
+      reader.fail("compliance", "no compliance unless \"solver\": {\"xpbd\": true}", reader.raw("compliance"));
+    }
+    material.compliance = reader.number("compliance", 0.0, {0.0, 1.0, false, "m/N"});
   } else {
     material.stiffness = reader.number("stiffness", material.stiffness, {0.0, 1.0e9, false, "N/m"});
     material.damping = reader.number("damping", material.damping, {0.0, 1.0e6, false, "N s/m"});
@@ -61,7 +65,7 @@ KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model)
   return material;
 }
 
-sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& particleBudget) {
+sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long long& particleBudget) {
   sim::ClothSettings cloth;
   ObjectReader grid = reader.object("grid");
   sim::LatticeSpec& lattice = cloth.lattice;
@@ -83,7 +87,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, long long& parti
   cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
   cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
   cloth.thickness = reader.number("thickness", cloth.thickness, {1.0e-4, 0.1, false, "m"});
-  for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model);
+  for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model, xpbd);
 
   const json& pins = reader.array("pins", kMaxPins);
   for (std::size_t i = 0; i < pins.size(); ++i) {
@@ -131,6 +135,13 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.substeps = solver.integer("substeps", world.solver.substeps, 1, sim::kMaxSubsteps);
     world.solver.iterations = solver.integer("iterations", world.solver.iterations, 0, sim::kMaxIterations);
     world.solver.damping = solver.number("damping", 0.0, {0.0, 1000.0, false, "1/s"});
+    world.solver.xpbd = solver.boolean("xpbd", false);
+    world.solver.tethers = solver.boolean("tethers", false);
+    if ((world.solver.xpbd || world.solver.tethers) && world.solver.model != Model::position) {
+      solver.fail(world.solver.xpbd ? "xpbd" : "tethers",
+                  "false for the force model (it belongs to the position model)",
+                  solver.raw(world.solver.xpbd ? "xpbd" : "tethers"));
+    }
     solver.finish();
   }
   world.gravity = root.vec3("gravity", world.gravity, 1000.0, "m/s^2");
@@ -154,7 +165,7 @@ Scene parseScene(const json& document, const std::string& source) {
   long long particleBudget = sim::kMaxParticles;
   for (std::size_t i = 0; i < cloths.size(); ++i) {
     ObjectReader cloth(cloths[i], "cloths." + std::to_string(i), source);
-    world.cloths.push_back(readCloth(cloth, world.solver.model, particleBudget));
+    world.cloths.push_back(readCloth(cloth, world.solver.model, world.solver.xpbd, particleBudget));
   }
   root.finish();
   return scene;

@@ -71,15 +71,62 @@ void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inver
   position[c.b] -= wb * correction;
 }
 
-void projectConstraints(Cloth& cloth, int iterations, SolverScratch* contacts) {
+namespace {
+
+// XPBD (Macklin et al. 2016, eq. 18): with C = |x_b - x_a| - r and alpha~ = compliance / h^2,
+// dlambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~), x_a -= w_a dlambda n, x_b += w_b dlambda n.
+void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inverseMass, const DistanceConstraint& c,
+                      Real alphaTilde, Real& lambda) {
+  const Real wa = inverseMass[c.a], wb = inverseMass[c.b];
+  const Real denominator = wa + wb + alphaTilde;
+  if (denominator == 0.0) return;
+  const Vec3 d = position[c.b] - position[c.a];
+  const Real length2 = glm::dot(d, d);
+  if (!(length2 > 1e-20)) return;
+  const Real length = std::sqrt(length2);
+  const Real deltaLambda = (-(length - c.restLength) - alphaTilde * lambda) / denominator;
+  lambda += deltaLambda;
+  const Vec3 n = d / length;
+  position[c.a] -= n * (wa * deltaLambda);
+  position[c.b] += n * (wb * deltaLambda);
+}
+
+void projectTethers(ParticleState& s, const std::vector<SolverScratch::Tether>& tethers) {
+  for (const SolverScratch::Tether& t : tethers) {
+    if (s.inverseMass[t.pin] != 0.0) continue;  // the anchor was let go
+    const Vec3 d = s.position[t.particle] - s.position[t.pin];
+    const Real length = glm::length(d);
+    if (length > t.length) s.position[t.particle] = s.position[t.pin] + d * (t.length / length);
+  }
+}
+
+}  // namespace
+
+void projectConstraints(Cloth& cloth, int iterations, Real h, bool xpbd, SolverScratch& scratch, bool contacts) {
   ParticleState& s = cloth.state;
+  if (xpbd) {
+    for (ConstraintKind kind : kConstraintKinds) {
+      scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
+    }
+  }
   for (int iteration = 0; iteration < iterations; ++iteration) {
     for (ConstraintKind kind : kConstraintKinds) {
-      const Real stiffness = cloth.settings.material(kind).stiffness;
-      if (stiffness == 0.0) continue;
-      for (const DistanceConstraint& c : cloth.rest.of(kind)) projectDistance(s.position, s.inverseMass, c, stiffness);
+      const KindMaterial& material = cloth.settings.material(kind);
+      if (material.stiffness == 0.0) continue;
+      const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
+      if (xpbd) {
+        const Real alphaTilde = material.compliance / (h * h);
+        std::vector<Real>& lambda = scratch.lambda[static_cast<std::size_t>(kind)];
+        for (std::size_t k = 0; k < constraints.size(); ++k) {
+          projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
+        }
+      } else {
+        for (const DistanceConstraint& c : constraints)
+          projectDistance(s.position, s.inverseMass, c, material.stiffness);
+      }
     }
-    if (contacts) contact::project(cloth, *contacts);
+    if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers);
+    if (contacts) contact::project(cloth, scratch);
   }
 }
 

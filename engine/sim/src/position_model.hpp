@@ -34,7 +34,9 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
 // With equal masses and k = 1 that is exactly the seed's dx_1 = 1/2 (|x2 - x1| - r)(x2 - x1)/|x2 - x1|.
 // With `contacts`, the contact planes are re-enforced after every sweep, so the constraints cannot
 // pull a particle back into a collider.
-void projectConstraints(Cloth& cloth, int iterations, SolverScratch* contacts);
+// With `xpbd`, each kind resists with its compliance instead (see settings.hpp); with tethers in
+// `scratch`, they are enforced after every sweep too.
+void projectConstraints(Cloth& cloth, int iterations, Real h, bool xpbd, SolverScratch& scratch, bool contacts);
 
 // Removes the kind's damping fraction of the relative velocity along each constraint, by moving
 // x_prev, conserving momentum.

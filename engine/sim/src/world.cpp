@@ -60,6 +60,9 @@ void validate(const WorldSettings& s) {
   require(particles <= kMaxParticles, "too many particles");
   for (const ClothSettings& cloth : s.cloths) {
     require(finite(cloth.thickness) && cloth.thickness > 0.0, "cloth thickness must be positive");
+    for (const KindMaterial& m : cloth.materials) {
+      require(finite(m.compliance) && m.compliance >= 0.0, "constraint compliance must be finite and >= 0");
+    }
   }
   const SelfCollisionSettings& self = s.selfCollision;
   require(finite(self.distance) && self.distance > 0.0 && finite(self.friction) && self.friction >= 0.0 &&
@@ -149,6 +152,21 @@ World::World(WorldSettings settings) : settings_(std::move(settings)), topologyV
     }
   }
   scratch_.resize(cloths_.size());
+  if (settings_.solver.tethers && model == Model::position) {
+    for (std::size_t c = 0; c < cloths_.size(); ++c) {
+      const Cloth& cloth = cloths_[c];
+      for (std::size_t p = 0; p < cloth.state.position.size(); ++p) {
+        if (cloth.state.inverseMass[p] != 0.0) continue;
+        for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+          if (cloth.state.inverseMass[i] == 0.0) continue;
+          // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
+          const Real length = glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]);
+          scratch_[c].tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
+        }
+      }
+      anyProjected = anyProjected || !scratch_[c].tethers.empty();
+    }
+  }
   for (const ColliderSettings& collider : settings_.colliders) colliders_.emplace_back(collider);
   const bool anyColliders = !colliders_.empty();
   const bool selfCollision = settings_.selfCollision.enabled && model == Model::position;
@@ -210,7 +228,8 @@ void World::runStage(Stage stage) {
         position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration);
         break;
       case Stage::projectConstraints:
-        position::projectConstraints(cloth, settings_.solver.iterations, colliders_.empty() ? nullptr : &scratch);
+        position::projectConstraints(cloth, settings_.solver.iterations, h, settings_.solver.xpbd, scratch,
+                                     !colliders_.empty());
         break;
       case Stage::dampConstraints: position::dampConstraints(cloth); break;
       case Stage::clampTravel:

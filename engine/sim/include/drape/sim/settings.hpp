@@ -39,6 +39,13 @@ struct SolverSettings {
   int substeps = 1;                            // each step is split into this many equal substeps
   int iterations = 20;                         // position model: constraint sweeps per substep
   Real damping = 0.0;                          // 1/s, global velocity damping: a -= damping * v
+  // Position model: XPBD (Macklin, Mueller, Chentanez 2016) instead of the seed's stiffness-scaled
+  // projection. Each kind then resists with a compliance (m/N, the inverse of a spring constant),
+  // and the result no longer depends on the iteration count or the step.
+  bool xpbd = false;
+  // Position model: long-range attachments (Kim, Chentanez, Mueller 2012): no particle may be
+  // farther from a pin than it is at rest. One cheap inequality per particle and pin.
+  bool tethers = false;
 };
 
 // The air around the cloth, moving uniformly at `velocity`.
@@ -57,6 +64,7 @@ struct AirSettings {
 struct KindMaterial {
   Real stiffness = 1.0;
   Real damping = 0.0;
+  Real compliance = 0.0;  // m/N, XPBD only: 0 is rigid (a kind with stiffness 0 is still off)
 };
 
 struct Pin {

@@ -2,8 +2,11 @@
 // needs and nothing else.
 #pragma once
 
+#include <array>
 #include <cstdint>
+
 #include <vector>
+#include "drape/sim/cloth.hpp"
 
 #include "drape/sim/types.hpp"
 
@@ -33,6 +36,15 @@ struct SolverScratch {
   std::vector<Vec3> contactNormal;
   std::vector<Real> contactOffset;  // m
   std::vector<Real> contactDepth;   // m, penetration resolved this substep (for friction)
+  // XPBD: the Lagrange multiplier of every constraint, by kind, reset each substep.
+  std::array<std::vector<Real>, kConstraintKindCount> lambda;
+  // Tethers: particle, pinned particle, the longest they may be apart (m).
+  struct Tether {
+    ParticleIndex particle;
+    ParticleIndex pin;
+    Real length;
+  };
+  std::vector<Tether> tethers;
 };
 
 // The self-collision spatial hash over every particle of a world.
