@@ -48,3 +48,31 @@ TEST(Stability, BelowTheBoundTheSymplecticSchemesKeepTheirEnergy) {
 
 }  // namespace
 }  // namespace drape::analysis
+
+#include "drape/analysis/convergence.hpp"
+
+namespace drape::analysis {
+namespace {
+
+struct OrderCase {
+  Integrator integrator;
+  double order;
+};
+
+void PrintTo(const OrderCase& c, std::ostream* os) { *os << sim::name(c.integrator); }
+
+class Order : public ::testing::TestWithParam<OrderCase> {};
+
+TEST_P(Order, ObservedConvergenceOrderIsTheIntegratorsOrder) {
+  // Explicit and symplectic Euler 1, Verlet and midpoint 2, RK4 4.
+  const Convergence c = oscillatorConvergence(GetParam().integrator, 0.01, 5);
+  EXPECT_NEAR(c.order, GetParam().order, 0.25) << sim::name(GetParam().integrator);
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, Order,
+                         ::testing::Values(OrderCase{Integrator::explicitEuler, 1},
+                                           OrderCase{Integrator::symplecticEuler, 1}, OrderCase{Integrator::verlet, 2},
+                                           OrderCase{Integrator::midpoint, 2}, OrderCase{Integrator::rk4, 4}));
+
+}  // namespace
+}  // namespace drape::analysis

@@ -293,6 +293,31 @@ TEST_F(Cli, StabilityWritesItsMapPictureAndReport) {
   EXPECT_NE(text.find("never stable"), std::string::npos);
 }
 
+TEST_F(Cli, StudyReportsErrorAgainstTimeWithAParetoFront) {
+  const fs::path folder = file("accuracy"), report = file("accuracy.md");
+  const Result result = run("study chain --time 0.2 --repeats 1 --sweep solver.substeps=1,4 --quiet --out-dir '" +
+                            folder.string() + "' --report '" + report.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(fs::exists(folder / "accuracy.png"));
+  std::istringstream csv(read(folder / "accuracy.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "config,cpu_s_per_simulated_s,strain_max,strain_mean,rms_error_m,pareto");
+  double coarse = 0.0, fine = 0.0;
+  while (std::getline(csv, line)) {
+    const std::size_t comma = line.find(',', line.find('"', 1));
+    double time, strainMax, strainMean, error;
+    int pareto;
+    ASSERT_EQ(
+        std::sscanf(line.c_str() + comma + 1, "%lf,%lf,%lf,%lf,%d", &time, &strainMax, &strainMean, &error, &pareto), 5)
+        << line;
+    (line.find("substeps=1") != std::string::npos ? coarse : fine) = error;
+  }
+  EXPECT_LT(fine, coarse);  // four substeps land nearer the reference than one
+  EXPECT_NE(read(report).find("| rk4 |"), std::string::npos);
+  expectOneLineError(run("study chain --sweep solver.substeps"), 2, "--sweep solver.substeps: expected path=value1");
+}
+
 TEST_F(Cli, AStepCountPastTheLimitIsBadInput) {
   expectOneLineError(run("run hang --set duration=100000 --set solver.dt=1e-6"), 2,
                      "duration / solver.dt asks for 100000000000 steps, more than the limit of 1000000000");

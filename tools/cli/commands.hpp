@@ -51,7 +51,19 @@ struct StabilityArguments {
   bool quiet = false;
 };
 
+struct StudyArguments {
+  SceneArguments input;
+  std::optional<std::int64_t> steps;
+  std::optional<double> seconds;
+  std::vector<std::string> sweeps;    // path=v1,v2,...
+  int repeats = 3;
+  std::string outDir = "accuracy";
+  std::optional<std::string> report;
+  bool quiet = false;
+};
+
 int validate(const SceneArguments& arguments);
+int study(const StudyArguments& arguments);
 int stability(const StabilityArguments& arguments);
 int render(const RenderArguments& arguments);
 int run(const RunArguments& arguments);

@@ -73,6 +73,18 @@ int main(int argc, char** argv) {
   stabilityCommand->add_option("--report", stabilityArguments.report, "Also write a Markdown report here");
   stabilityCommand->add_flag("--quiet", stabilityArguments.quiet, "Print nothing on success");
 
+  StudyArguments studyArguments;
+  CLI::App* studyCommand =
+      app.add_subcommand("study", "Error against run time over configurations of a scene, and integrator orders");
+  addSceneOptions(studyCommand, studyArguments.input);
+  addLengthOptions(studyCommand, studyArguments.steps, studyArguments.seconds);
+  studyCommand->add_option("--sweep", studyArguments.sweeps, "path=v1,v2,... (repeatable: every combination runs)");
+  studyCommand->add_option("--repeats", studyArguments.repeats, "Timed runs per configuration (median)")
+      ->check(CLI::Range(1, 100));
+  studyCommand->add_option("--out-dir", studyArguments.outDir, "Folder for CSV and picture (default accuracy)");
+  studyCommand->add_option("--report", studyArguments.report, "Also write a Markdown report here");
+  studyCommand->add_flag("--quiet", studyArguments.quiet, "Print nothing on success");
+
   app.add_subcommand("scenes", "List the shipped scenes");
 
   try {
@@ -87,6 +99,7 @@ int main(int argc, char** argv) {
     if (*runCommand) return run(runArguments);
     if (*renderCommand) return render(renderArguments);
     if (*stabilityCommand) return stability(stabilityArguments);
+    if (*studyCommand) return study(studyArguments);
     return listScenes();
   } catch (const std::exception& error) {  // a bug, not bad input: say so rather than abort
     std::cerr << "drape-cli: internal error: " << error.what() << "\n";
