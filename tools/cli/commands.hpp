@@ -55,7 +55,7 @@ struct StudyArguments {
   SceneArguments input;
   std::optional<std::int64_t> steps;
   std::optional<double> seconds;
-  std::vector<std::string> sweeps;    // path=v1,v2,...
+  std::vector<std::string> sweeps;  // path=v1,v2,...
   int repeats = 3;
   std::string outDir = "accuracy";
   std::optional<std::string> report;

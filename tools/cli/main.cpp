@@ -22,6 +22,13 @@ void addLengthOptions(CLI::App* command, std::optional<std::int64_t>& steps, std
       ->excludes(stepsOption);
 }
 
+// --out-dir, --report and --quiet of the studies.
+void addReportOptions(CLI::App* command, std::string& outDir, std::optional<std::string>& report, bool& quiet) {
+  command->add_option("--out-dir", outDir, "Folder for CSV and picture (default " + outDir + ")");
+  command->add_option("--report", report, "Also write a Markdown report here");
+  command->add_flag("--quiet", quiet, "Print nothing on success");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -68,10 +75,7 @@ int main(int argc, char** argv) {
   StabilityArguments stabilityArguments;
   CLI::App* stabilityCommand = app.add_subcommand(
       "stability", "Map where each force-model integrator is stable (stiffness x dt) against linear theory");
-  stabilityCommand->add_option("--out-dir", stabilityArguments.outDir,
-                               "Folder for CSV and picture (default stability)");
-  stabilityCommand->add_option("--report", stabilityArguments.report, "Also write a Markdown report here");
-  stabilityCommand->add_flag("--quiet", stabilityArguments.quiet, "Print nothing on success");
+  addReportOptions(stabilityCommand, stabilityArguments.outDir, stabilityArguments.report, stabilityArguments.quiet);
 
   StudyArguments studyArguments;
   CLI::App* studyCommand =
@@ -81,9 +85,7 @@ int main(int argc, char** argv) {
   studyCommand->add_option("--sweep", studyArguments.sweeps, "path=v1,v2,... (repeatable: every combination runs)");
   studyCommand->add_option("--repeats", studyArguments.repeats, "Timed runs per configuration (median)")
       ->check(CLI::Range(1, 100));
-  studyCommand->add_option("--out-dir", studyArguments.outDir, "Folder for CSV and picture (default accuracy)");
-  studyCommand->add_option("--report", studyArguments.report, "Also write a Markdown report here");
-  studyCommand->add_flag("--quiet", studyArguments.quiet, "Print nothing on success");
+  addReportOptions(studyCommand, studyArguments.outDir, studyArguments.report, studyArguments.quiet);
 
   app.add_subcommand("scenes", "List the shipped scenes");
 
