@@ -103,3 +103,20 @@ TEST(Analytic, AHangingChainSettlesIntoTheCatenaryOfItsLengthAndSpan) {
 
 }  // namespace
 }  // namespace drape::analysis
+
+namespace drape::analysis {
+namespace {
+
+TEST(Stability, ThePositionModelNeverDivergesOverStiffnessAndStep) {
+  for (PositionSystem system : {PositionSystem::chain, PositionSystem::sheet}) {
+    for (double stiffness : {0.01, 1.0}) {
+      for (double dt : {0.001, 0.1}) {
+        EXPECT_NE(runPositionModel(system, stiffness, dt, 200).verdict, Stability::diverged)
+            << name(system) << " k=" << stiffness << " dt=" << dt;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace drape::analysis

@@ -37,6 +37,16 @@ struct OscillatorRun {
 
 OscillatorRun runOscillator(sim::Integrator integrator, double stiffness, double dt, std::int64_t steps);
 
+// The position model on a chain (a 1 m, 20-link pendulum released horizontally) or a sheet (a
+// 1 m, 16 x 16 sheet held by two corners, falling from flat), at a 0..1 stiffness and a step dt
+// (one substep, 10 iterations), for `steps` steps. The energy scale is the potential energy
+// released by a 1 m drop, m g (1 m): diverged if the guard trips or the mechanical energy ever
+// rises more than 10 scales above its start; damped if the kinetic energy at the end is below
+// 1e-3 scales (it has come to rest); stable otherwise.
+enum class PositionSystem : std::uint8_t { chain, sheet };
+std::string_view name(PositionSystem system);
+OscillatorRun runPositionModel(PositionSystem system, double stiffness, double dt, std::int64_t steps);
+
 // The theoretical bound omega * dt below which the undamped oscillator is stable; none if never.
 std::optional<double> theoreticalStableOmegaDt(sim::Integrator integrator);
 
