@@ -219,6 +219,13 @@ void World::startHistory() {
 
 void World::runStage(Stage stage) {
   const Real h = static_cast<Real>(substepDt());
+  // Work over the whole world first: colliders move once per substep, and self-collision spans
+  // every cloth at once.
+  if (stage == Stage::collide || stage == Stage::collideForces) moveColliders();
+  if (stage == Stage::selfCollide) {
+    contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_);
+    return;
+  }
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     Cloth& cloth = cloths_[c];
     SolverScratch& scratch = scratch_[c];
@@ -235,23 +242,15 @@ void World::runStage(Stage stage) {
       case Stage::clampTravel:
         contact::clampTravel(cloth, settings_.selfCollision.maxTravel * settings_.selfCollision.distance);
         break;
-      case Stage::collide:
-        if (c == 0) moveColliders();
-        contact::detect(cloth, colliders_, scratch);
-        break;
+      case Stage::collide: contact::detect(cloth, colliders_, scratch); break;
       case Stage::friction: contact::friction(cloth, colliders_, h, scratch); break;
-      case Stage::selfCollide:
-        if (c == 0) contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_);
-        break;
-      case Stage::collideForces:
-        if (c == 0) moveColliders();
-        contact::respondWithVelocities(cloth, colliders_, h, scratch);
-        break;
+      case Stage::collideForces: contact::respondWithVelocities(cloth, colliders_, h, scratch); break;
       case Stage::explicitEuler:
       case Stage::symplecticEuler:
       case Stage::verletForces:
       case Stage::midpoint:
       case Stage::rk4: force::step(settings_.solver.integrator, cloth, settings_, h, scratch); break;
+      case Stage::selfCollide:  // world-wide, above
       case Stage::guard: break;
     }
   }
@@ -286,8 +285,14 @@ StepStatus World::step() {
   using Clock = std::chrono::steady_clock;
   if (divergence_) return StepStatus::diverged;
   if (!historyStarted_) startHistory();
+  // Only what a step changes is kept (inverse masses do not change within a step).
   lastGood_.resize(cloths_.size());
-  for (std::size_t c = 0; c < cloths_.size(); ++c) lastGood_[c] = cloths_[c].state;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    const ParticleState& s = cloths_[c].state;
+    lastGood_[c].position = s.position;
+    lastGood_[c].previousPosition = s.previousPosition;
+    lastGood_[c].velocity = s.velocity;
+  }
 
   for (StageTiming& timing : profile_) timing.lastSeconds = 0.0;
   for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
@@ -308,7 +313,12 @@ StepStatus World::step() {
   for (StageTiming& timing : profile_) timing.totalSeconds += timing.lastSeconds;
 
   if (divergence_) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) cloths_[c].state = lastGood_[c];
+    for (std::size_t c = 0; c < cloths_.size(); ++c) {
+      ParticleState& s = cloths_[c].state;
+      s.position = lastGood_[c].position;
+      s.previousPosition = lastGood_[c].previousPosition;
+      s.velocity = lastGood_[c].velocity;
+    }
     for (Collider& collider : colliders_) collider.setTime(time());  // back where the good state saw them
     return StepStatus::diverged;
   }

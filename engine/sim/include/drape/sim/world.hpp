@@ -72,8 +72,11 @@ class World {
   std::vector<SolverScratch> scratch_;  // per cloth
   std::vector<Collider> colliders_;
   SelfCollisionScratch selfCollisionScratch_;
-  int substep_ = 0;                      // within the current step
-  std::vector<ParticleState> lastGood_;  // state before the current step
+  int substep_ = 0;  // within the current step
+  struct Snapshot {
+    std::vector<Vec3> position, previousPosition, velocity;
+  };
+  std::vector<Snapshot> lastGood_;  // what the current step changes, as it was before it
 };
 
 }  // namespace drape::sim
