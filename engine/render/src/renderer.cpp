@@ -27,6 +27,13 @@ namespace {
 constexpr int kShadowMapSize = 2048;
 const glm::dvec3 kTowardsLight = glm::normalize(glm::dvec3{0.35, 1.0, 0.25});
 
+// A GL info log as the one-line message of a RenderError.
+[[noreturn]] void fail(const std::string& what, const char* log) {
+  std::string message = what + ": " + log;
+  std::replace(message.begin(), message.end(), '\n', ' ');
+  throw RenderError(message);
+}
+
 GLuint compile(GLenum kind, std::string_view source, const char* name) {
   const GLuint shader = glCreateShader(kind);
   const char* text = source.data();
@@ -39,16 +46,20 @@ GLuint compile(GLenum kind, std::string_view source, const char* name) {
     char log[2048] = {};
     glGetShaderInfoLog(shader, sizeof log, nullptr, log);
     glDeleteShader(shader);
-    std::string message = std::string("shader ") + name + " does not compile: " + log;
-    std::replace(message.begin(), message.end(), '\n', ' ');
-    throw RenderError(message);
+    fail(std::string("shader ") + name + " does not compile", log);
   }
   return shader;
 }
 
 GLuint link(std::string_view vertex, std::string_view fragment, const char* name) {
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex, name);
-  const GLuint fs = compile(GL_FRAGMENT_SHADER, fragment, name);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragment, name);
+  } catch (const RenderError&) {
+    glDeleteShader(vs);
+    throw;
+  }
   const GLuint program = glCreateProgram();
   glAttachShader(program, vs);
   glAttachShader(program, fs);
@@ -60,7 +71,8 @@ GLuint link(std::string_view vertex, std::string_view fragment, const char* name
   if (!ok) {
     char log[2048] = {};
     glGetProgramInfoLog(program, sizeof log, nullptr, log);
-    throw RenderError(std::string("program ") + name + " does not link: " + log);
+    glDeleteProgram(program);
+    fail(std::string("program ") + name + " does not link", log);
   }
   return program;
 }
