@@ -228,7 +228,7 @@ struct Renderer::Impl {
     const std::size_t n = cloth.state.position.size();
     positions.resize(n);
     for (std::size_t i = 0; i < n; ++i) positions[i] = glm::vec3(cloth.state.position[i]);
-    normalScratch = sim::vertexNormals(cloth);
+    sim::vertexNormals(cloth, normalScratch);
     normals.resize(n);
     for (std::size_t i = 0; i < n; ++i) normals[i] = glm::vec3(normalScratch[i]);
     strains.assign(n, 0.0f);

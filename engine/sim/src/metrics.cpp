@@ -56,8 +56,14 @@ Energy energy(const World& world) {
 }
 
 std::vector<Vec3> vertexNormals(const Cloth& cloth) {
+  std::vector<Vec3> normals;
+  vertexNormals(cloth, normals);
+  return normals;
+}
+
+void vertexNormals(const Cloth& cloth, std::vector<Vec3>& normals) {
   const std::vector<Vec3>& x = cloth.state.position;
-  std::vector<Vec3> normals(x.size(), Vec3{0.0});
+  normals.assign(x.size(), Vec3{0.0});
   for (const glm::uvec3& t : cloth.rest.triangles) {
     const Vec3 n = glm::cross(x[t.y] - x[t.x], x[t.z] - x[t.x]);  // length = twice the area
     normals[t.x] += n;
@@ -69,7 +75,6 @@ std::vector<Vec3> vertexNormals(const Cloth& cloth) {
     const Real length = glm::length(n);
     n = length > 0.0 ? n / length : planeNormal;
   }
-  return normals;
 }
 
 }  // namespace drape::sim

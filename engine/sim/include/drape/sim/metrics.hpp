@@ -29,5 +29,6 @@ Energy energy(const World& world);
 // Per-vertex normals (area-weighted sum of adjacent triangle normals, normalised); particles on no
 // triangle get the lattice plane's normal.
 std::vector<Vec3> vertexNormals(const Cloth& cloth);
+void vertexNormals(const Cloth& cloth, std::vector<Vec3>& normals);  // into an array reused frame to frame
 
 }  // namespace drape::sim
