@@ -152,6 +152,7 @@ void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders,
 void clampTravel(Cloth& cloth, Real maxTravel) {
   ParticleState& s = cloth.state;
   for (std::size_t i = 0; i < s.position.size(); ++i) {
+    if (s.inverseMass[i] == 0.0) continue;  // a finger or pin moves it, as fast as it likes
     const Vec3 travel = s.position[i] - s.previousPosition[i];
     const Real length = glm::length(travel);
     if (length > maxTravel) s.previousPosition[i] = s.position[i] - travel * (maxTravel / length);

@@ -34,9 +34,9 @@ Energy energy(const World& world) {
   const Vec3 g = world.settings().gravity;
   for (std::size_t c = 0; c < world.cloths().size(); ++c) {
     const Cloth& cloth = world.cloths()[c];
-    const double m = cloth.particleMass;
     for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-      if (cloth.state.inverseMass[i] == 0.0) continue;  // pinned: held by the world, no energy of its own
+      if (cloth.state.inverseMass[i] == 0.0) continue;  // pinned or held: moved by the world, no energy of its own
+      const double m = cloth.state.mass[i];
       const Vec3 v = world.velocity(static_cast<int>(c), static_cast<ParticleIndex>(i));
       e.kinetic += 0.5 * m * static_cast<double>(glm::dot(v, v));
       e.gravitational -= m * static_cast<double>(glm::dot(g, cloth.state.position[i]));

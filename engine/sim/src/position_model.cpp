@@ -46,7 +46,14 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
   const Vec3 constantAcceleration = world.gravity + world.air.drag * world.air.velocity;
   const Real h2 = h * h * relaxed;
   for (std::size_t i = 0; i < s.position.size(); ++i) {
-    if (s.inverseMass[i] == 0.0) continue;
+    if (s.inverseMass[i] == 0.0) {
+      // Pinned or held: no force moves it, only the world does. It carries on as it was set to move
+      // (a finger sets x_prev one finger step behind); a pin has x_prev = x and stays exactly put.
+      const Vec3 x = s.position[i];
+      s.position[i] = x + (x - s.previousPosition[i]);
+      s.previousPosition[i] = x;
+      continue;
+    }
     Vec3 acceleration = constantAcceleration;
     if (extraAcceleration) acceleration += (*extraAcceleration)[i];
     const Vec3 x = s.position[i];
@@ -93,7 +100,8 @@ void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inve
 
 void projectTethers(ParticleState& s, const std::vector<SolverScratch::Tether>& tethers) {
   for (const SolverScratch::Tether& t : tethers) {
-    if (s.inverseMass[t.pin] != 0.0) continue;  // the anchor was let go
+    // The anchor was let go, or a finger holds the particle (then the finger decides where it is).
+    if (s.inverseMass[t.pin] != 0.0 || s.inverseMass[t.particle] == 0.0) continue;
     const Vec3 d = s.position[t.particle] - s.position[t.pin];
     const Real length = glm::length(d);
     if (length > t.length) s.position[t.particle] = s.position[t.pin] + d * (t.length / length);

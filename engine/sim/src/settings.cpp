@@ -53,7 +53,9 @@ std::string_view name(Stage stage) {
     case Stage::verletForces: return "verlet (forces)";
     case Stage::midpoint: return "midpoint";
     case Stage::rk4: return "rk4";
+    case Stage::fingers: return "fingers";
     case Stage::guard: return "guard";
+    case Stage::tear: return "tear";
   }
   return "?";
 }

@@ -12,6 +12,7 @@
 #include "contacts.hpp"
 #include "force_model.hpp"
 #include "position_model.hpp"
+#include "topology.hpp"
 
 namespace drape::sim {
 
@@ -22,6 +23,35 @@ bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::is
 
 void require(bool condition, const std::string& what) {
   if (!condition) throw std::invalid_argument(what);
+}
+
+void validateCloth(const ClothSettings& cloth, Model model) {
+  const long long clothParticles = static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
+  require(clothParticles <= kMaxParticles, "too many particles");
+  require(finite(cloth.mass) && cloth.mass > 0.0, "cloth mass must be positive");
+  require(std::isfinite(static_cast<Real>(clothParticles) / cloth.mass) &&
+              cloth.mass / static_cast<Real>(clothParticles) > 0.0,
+          "cloth mass per particle must be a positive number with a finite inverse");
+  require(finite(cloth.lattice.origin), "cloth origin must be finite");
+  require(finite(cloth.initialVelocity), "cloth velocity must be finite");
+  for (const KindMaterial& m : cloth.materials) {
+    require(finite(m.stiffness) && m.stiffness >= 0.0 && finite(m.damping) && m.damping >= 0.0,
+            "constraint stiffness and damping must be finite and >= 0");
+    if (model == Model::position) {
+      require(m.stiffness <= 1.0 && m.damping <= 1.0, "position-model stiffness and damping must be in 0..1");
+    }
+    require(finite(m.compliance) && m.compliance >= 0.0, "constraint compliance must be finite and >= 0");
+  }
+  for (const Pin& pin : cloth.pins) {
+    require(pin.column >= 0 && pin.column < cloth.lattice.columns && pin.row >= 0 && pin.row < cloth.lattice.rows,
+            "pin outside the lattice");
+    require(!pin.position || finite(*pin.position), "pin position must be finite");
+  }
+  require(finite(cloth.thickness) && cloth.thickness > 0.0, "cloth thickness must be positive");
+}
+
+void validateTearing(const TearSettings& tearing) {
+  require(finite(tearing.threshold) && tearing.threshold > 1.0, "tearing threshold must be a number above 1");
 }
 
 void validate(const WorldSettings& s) {
@@ -35,35 +65,13 @@ void validate(const WorldSettings& s) {
   require(finite(s.air.velocity), "wind velocity must be finite");
   require(finite(s.air.drag) && s.air.drag >= 0.0, "wind drag must be finite and >= 0");
   require(finite(s.air.pressure) && s.air.pressure >= 0.0, "wind pressure must be finite and >= 0");
+  validateTearing(s.tearing);
   long long particles = 0;
   for (const ClothSettings& cloth : s.cloths) {
+    validateCloth(cloth, solver.model);
     particles += static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
-    require(finite(cloth.mass) && cloth.mass > 0.0, "cloth mass must be positive");
-    const Real clothParticles = static_cast<Real>(cloth.lattice.columns) * cloth.lattice.rows;
-    require(std::isfinite(clothParticles / cloth.mass) && cloth.mass / clothParticles > 0.0,
-            "cloth mass per particle must be a positive number with a finite inverse");
-    require(finite(cloth.lattice.origin), "cloth origin must be finite");
-    require(finite(cloth.initialVelocity), "cloth velocity must be finite");
-    for (const KindMaterial& m : cloth.materials) {
-      require(finite(m.stiffness) && m.stiffness >= 0.0 && finite(m.damping) && m.damping >= 0.0,
-              "constraint stiffness and damping must be finite and >= 0");
-      if (solver.model == Model::position) {
-        require(m.stiffness <= 1.0 && m.damping <= 1.0, "position-model stiffness and damping must be in 0..1");
-      }
-    }
-    for (const Pin& pin : cloth.pins) {
-      require(pin.column >= 0 && pin.column < cloth.lattice.columns && pin.row >= 0 && pin.row < cloth.lattice.rows,
-              "pin outside the lattice");
-      require(!pin.position || finite(*pin.position), "pin position must be finite");
-    }
   }
   require(particles <= kMaxParticles, "too many particles");
-  for (const ClothSettings& cloth : s.cloths) {
-    require(finite(cloth.thickness) && cloth.thickness > 0.0, "cloth thickness must be positive");
-    for (const KindMaterial& m : cloth.materials) {
-      require(finite(m.compliance) && m.compliance >= 0.0, "constraint compliance must be finite and >= 0");
-    }
-  }
   const SelfCollisionSettings& self = s.selfCollision;
   require(finite(self.distance) && self.distance > 0.0 && finite(self.friction) && self.friction >= 0.0 &&
               self.friction <= 1.0 && finite(self.maxTravel) && self.maxTravel > 0.0,
@@ -110,13 +118,16 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
                                                used(settings.material(ConstraintKind::shear)),
                                                used(settings.material(ConstraintKind::bend))});
   const std::size_t n = cloth.rest.particleCount();
-  cloth.particleMass = settings.mass / static_cast<Real>(n);
+  const Real particleMass = settings.mass / static_cast<Real>(n);
   ParticleState& s = cloth.state;
   s.position = cloth.rest.restPositions;
-  s.inverseMass.assign(n, 1.0 / cloth.particleMass);
+  s.mass.assign(n, particleMass);
+  s.inverseMass.assign(n, 1.0 / particleMass);
+  s.pinned.assign(n, 0);
   for (const Pin& pin : settings.pins) {
     const ParticleIndex p = cloth.rest.index(pin.column, pin.row);
     s.inverseMass[p] = 0.0;
+    s.pinned[p] = 1;
     if (pin.position) s.position[p] = *pin.position;
   }
   s.previousPosition = s.position;
@@ -126,7 +137,13 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
       if (s.inverseMass[i] == 0.0) s.velocity[i] = Vec3{0.0};
     }
   }
+  cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
   return cloth;
+}
+
+// Every unpinned particle with all its array entries grown to `n` (new entries zero).
+void grow(std::vector<Vec3>& array, std::size_t n) {
+  if (!array.empty()) array.resize(n, Vec3{0.0});
 }
 
 }  // namespace
@@ -139,39 +156,62 @@ std::uint64_t nextTopologyVersion() {
 
 World::World(WorldSettings settings) : settings_(std::move(settings)), topologyVersion_(nextTopologyVersion()) {
   validate(settings_);
-  const Model model = settings_.solver.model;
-  bool anyTriangles = false, anyProjected = false, anyDamped = false;
   for (const ClothSettings& clothSettings : settings_.cloths) {
-    cloths_.push_back(makeCloth(clothSettings, model));
-    const Cloth& cloth = cloths_.back();
-    anyTriangles = anyTriangles || !cloth.rest.triangles.empty();
-    for (ConstraintKind kind : kConstraintKinds) {
-      if (cloth.rest.of(kind).empty()) continue;
-      anyProjected = anyProjected || clothSettings.material(kind).stiffness > 0.0;
-      anyDamped = anyDamped || clothSettings.material(kind).damping > 0.0;
-    }
+    cloths_.push_back(makeCloth(clothSettings, settings_.solver.model));
   }
   scratch_.resize(cloths_.size());
-  if (settings_.solver.tethers && model == Model::position) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) {
-      const Cloth& cloth = cloths_[c];
-      for (std::size_t p = 0; p < cloth.state.position.size(); ++p) {
-        if (cloth.state.inverseMass[p] != 0.0) continue;
-        for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-          if (cloth.state.inverseMass[i] == 0.0) continue;
-          // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
-          const Real length = glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]);
-          scratch_[c].tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
-        }
-      }
-      anyProjected = anyProjected || !scratch_[c].tethers.empty();
-    }
+  held_.resize(cloths_.size());
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    held_[c].assign(cloths_[c].state.position.size(), 0);
+    buildTethers(c);
   }
   for (const ColliderSettings& collider : settings_.colliders) colliders_.emplace_back(collider);
+  buildPipeline();
+}
+
+void World::buildTethers(std::size_t c) {
+  if (!settings_.solver.tethers || settings_.solver.model != Model::position) return;
+  const Cloth& cloth = cloths_[c];
+  for (std::size_t p = 0; p < cloth.state.position.size(); ++p) {
+    if (!cloth.state.pinned[p]) continue;
+    for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+      if (cloth.state.inverseMass[i] == 0.0) continue;
+      // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
+      const Real length = glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]);
+      scratch_[c].tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
+    }
+  }
+}
+
+void World::buildPipeline() {
+  const Model model = settings_.solver.model;
+  bool anyTriangles = false, anyProjected = false, anyDamped = false;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    const Cloth& cloth = cloths_[c];
+    anyTriangles = anyTriangles || !cloth.rest.triangles.empty();
+    anyProjected = anyProjected || !scratch_[c].tethers.empty();
+    for (ConstraintKind kind : kConstraintKinds) {
+      if (cloth.rest.of(kind).empty()) continue;
+      anyProjected = anyProjected || cloth.settings.material(kind).stiffness > 0.0;
+      anyDamped = anyDamped || cloth.settings.material(kind).damping > 0.0;
+    }
+  }
   const bool anyColliders = !colliders_.empty();
   const bool selfCollision = settings_.selfCollision.enabled && model == Model::position;
+  bool anyHeld = false;
+  for (const Finger& finger : fingers_) anyHeld = anyHeld || !finger.grips.empty();
 
-  const auto add = [this](Stage stage, bool perSubstep) { profile_.push_back({stage, perSubstep}); };
+  // Timings carry over for the stages that stay.
+  const Profile old = std::move(profile_);
+  profile_.clear();
+  const auto add = [&](Stage stage, bool perSubstep) {
+    StageTiming timing{stage, perSubstep};
+    for (const StageTiming& before : old) {
+      if (before.stage == stage) timing.totalSeconds = before.totalSeconds;
+    }
+    profile_.push_back(timing);
+  };
+  if (anyHeld) add(Stage::fingers, true);
   if (model == Model::position) {
     if (settings_.air.pressure > 0.0 && anyTriangles) add(Stage::windPressure, true);
     add(Stage::verletIntegrate, true);
@@ -188,6 +228,7 @@ World::World(WorldSettings settings) : settings_(std::move(settings)), topologyV
     if (anyColliders) add(Stage::collideForces, true);
   }
   add(Stage::guard, false);
+  if (settings_.tearing.enabled && !cloths_.empty()) add(Stage::tear, false);
 }
 
 bool World::hasStage(Stage stage) const {
@@ -203,17 +244,19 @@ Vec3 World::velocity(int cloth, ParticleIndex particle) const {
   return (s.position.at(particle) - s.previousPosition.at(particle)) / static_cast<Real>(substepDt());
 }
 
-void World::startHistory() {
+void World::startHistory(std::size_t c) {
   const Real h = static_cast<Real>(substepDt());
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    if (settings_.solver.model == Model::position) {
-      if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(cloths_[c].state.position.size(), Vec3{0.0});
-      position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity,
-                             settings_.solver.damping + settings_.air.drag, h);
-    } else {
-      force::startHistory(cloths_[c], settings_, h, scratch_[c]);
-    }
+  if (settings_.solver.model == Model::position) {
+    if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(cloths_[c].state.position.size(), Vec3{0.0});
+    position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity,
+                           settings_.solver.damping + settings_.air.drag, h);
+  } else {
+    force::startHistory(cloths_[c], settings_, h, scratch_[c]);
   }
+}
+
+void World::startHistory() {
+  for (std::size_t c = 0; c < cloths_.size(); ++c) startHistory(c);
   historyStarted_ = true;
 }
 
@@ -224,6 +267,10 @@ void World::runStage(Stage stage) {
   if (stage == Stage::collide || stage == Stage::collideForces) moveColliders();
   if (stage == Stage::selfCollide) {
     contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_);
+    return;
+  }
+  if (stage == Stage::fingers) {
+    moveFingers(h);
     return;
   }
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
@@ -250,8 +297,10 @@ void World::runStage(Stage stage) {
       case Stage::verletForces:
       case Stage::midpoint:
       case Stage::rk4: force::step(settings_.solver.integrator, cloth, settings_, h, scratch); break;
+      case Stage::fingers:      // world-wide, above
       case Stage::selfCollide:  // world-wide, above
-      case Stage::guard: break;
+      case Stage::guard:        // once per step, in step()
+      case Stage::tear: break;
     }
   }
 }
@@ -308,6 +357,7 @@ StepStatus World::step() {
     if (timing.perSubstep) continue;
     const auto start = Clock::now();
     if (timing.stage == Stage::guard) divergence_ = findBadParticle();
+    if (timing.stage == Stage::tear && !divergence_) tear();
     timing.lastSeconds += std::chrono::duration<double>(Clock::now() - start).count();
   }
   for (StageTiming& timing : profile_) timing.totalSeconds += timing.lastSeconds;
@@ -322,6 +372,7 @@ StepStatus World::step() {
     for (Collider& collider : colliders_) collider.setTime(time());  // back where the good state saw them
     return StepStatus::diverged;
   }
+  for (Finger& finger : fingers_) finger.position = finger.target;
   ++stepCount_;
   return StepStatus::ok;
 }
@@ -331,6 +382,261 @@ StepStatus World::run(std::int64_t steps) {
     if (step() == StepStatus::diverged) return StepStatus::diverged;
   }
   return StepStatus::ok;
+}
+
+
+// ---- fingers ----------------------------------------------------------------------------------
+
+const Finger* World::finger(int id) const {
+  for (const Finger& f : fingers_) {
+    if (f.id == id) return &f;
+  }
+  return nullptr;
+}
+
+Finger* World::findFinger(int id) {
+  for (Finger& f : fingers_) {
+    if (f.id == id) return &f;
+  }
+  return nullptr;
+}
+
+void World::grab(Finger& finger, std::size_t c, ParticleIndex nearest) {
+  Cloth& cloth = cloths_[c];
+  ParticleState& s = cloth.state;
+  const Real r2 = finger.radius * finger.radius;
+  const std::uint32_t piece = cloth.piece[nearest];
+  for (std::size_t i = 0; i < s.position.size(); ++i) {
+    const Vec3 offset = s.position[i] - finger.position;
+    if (held_[c][i] || cloth.piece[i] != piece || glm::dot(offset, offset) > r2) continue;
+    held_[c][i] = 1;
+    s.inverseMass[i] = 0.0;
+    finger.grips.push_back({static_cast<int>(c), static_cast<ParticleIndex>(i), offset});
+  }
+}
+
+int World::pressFinger(int id, Vec3 point, Real radius) {
+  if (finger(id) || !finite(point) || !finite(radius) || !(radius > 0.0)) return -1;
+  Finger f;
+  f.id = id;
+  f.position = f.target = point;
+  f.radius = radius;
+  // The piece under the finger is the piece of the free particle nearest to it.
+  Real best = radius * radius;
+  std::optional<std::pair<std::size_t, ParticleIndex>> nearest;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    const ParticleState& s = cloths_[c].state;
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+      const Vec3 d = s.position[i] - point;
+      const Real d2 = glm::dot(d, d);
+      if (held_[c][i] || d2 > best) continue;
+      best = d2;
+      nearest = {{c, static_cast<ParticleIndex>(i)}};
+    }
+  }
+  if (nearest) grab(f, nearest->first, nearest->second);
+  fingers_.push_back(std::move(f));
+  buildPipeline();
+  return static_cast<int>(fingers_.back().grips.size());
+}
+
+std::optional<Vec3> World::pressFingerAlongRay(int id, Vec3 origin, Vec3 direction, Real radius) {
+  if (finger(id) || !finite(origin) || !finite(direction) || !(glm::length(direction) > 0.0) || !finite(radius) ||
+      !(radius > 0.0)) {
+    return std::nullopt;
+  }
+  const Vec3 unit = glm::normalize(direction);
+  std::optional<Real> first;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    const ParticleState& s = cloths_[c].state;
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+      if (held_[c][i]) continue;
+      const Vec3 d = s.position[i] - origin;
+      const Real t = glm::dot(d, unit);
+      if (t <= 0.0 || glm::dot(d, d) - t * t > radius * radius) continue;
+      if (!first || t < *first) first = t;
+    }
+  }
+  if (!first) return std::nullopt;
+  const Vec3 point = origin + unit * *first;
+  pressFinger(id, point, radius);
+  return point;
+}
+
+bool World::moveFinger(int id, Vec3 target) {
+  Finger* f = findFinger(id);
+  if (!f || !finite(target)) return false;
+  f->target = target;
+  return true;
+}
+
+bool World::releaseFinger(int id) {
+  Finger* f = findFinger(id);
+  if (!f) return false;
+  for (const FingerGrip& grip : f->grips) {
+    ParticleState& s = cloths_[static_cast<std::size_t>(grip.cloth)].state;
+    held_[static_cast<std::size_t>(grip.cloth)][grip.particle] = 0;
+    if (s.pinned[grip.particle]) {
+      // A pin the finger carried stays where it was put.
+      s.previousPosition[grip.particle] = s.position[grip.particle];
+      if (!s.velocity.empty()) s.velocity[grip.particle] = Vec3{0.0};
+    } else {
+      // x - x_prev (and the stored velocity) still hold the finger's last motion: it flies on.
+      s.inverseMass[grip.particle] = 1.0 / s.mass[grip.particle];
+    }
+  }
+  fingers_.erase(fingers_.begin() + (f - fingers_.data()));
+  buildPipeline();
+  return true;
+}
+
+int World::pinFinger(int id) {
+  Finger* f = findFinger(id);
+  if (!f) return -1;
+  for (const FingerGrip& grip : f->grips) cloths_[static_cast<std::size_t>(grip.cloth)].state.pinned[grip.particle] = 1;
+  const int pinned = static_cast<int>(f->grips.size());
+  releaseFinger(id);
+  return pinned;
+}
+
+int World::unpin(Vec3 point, Real radius) {
+  if (!finite(point) || !finite(radius) || !(radius > 0.0)) return 0;
+  int freed = 0;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    ParticleState& s = cloths_[c].state;
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+      const Vec3 d = s.position[i] - point;
+      if (!s.pinned[i] || held_[c][i] || glm::dot(d, d) > radius * radius) continue;
+      s.pinned[i] = 0;
+      s.inverseMass[i] = 1.0 / s.mass[i];
+      ++freed;
+    }
+  }
+  return freed;
+}
+
+void World::moveFingers(Real h) {
+  const Real n = static_cast<Real>(settings_.solver.substeps);
+  const Real from = static_cast<Real>(substep_) / n, to = static_cast<Real>(substep_ + 1) / n;
+  for (const Finger& f : fingers_) {
+    const Vec3 path = f.target - f.position;
+    const Vec3 start = f.position + path * from;
+    const Vec3 travel = path * (to - from);
+    for (const FingerGrip& grip : f.grips) {
+      // Set where the finger is at the start of the substep, and one substep's travel behind: the
+      // integrator then carries the particle to where the finger is at its end (inverse mass 0).
+      ParticleState& s = cloths_[static_cast<std::size_t>(grip.cloth)].state;
+      s.position[grip.particle] = start + grip.offset;
+      s.previousPosition[grip.particle] = start + grip.offset - travel;
+      if (!s.velocity.empty()) s.velocity[grip.particle] = travel / h;
+    }
+  }
+}
+
+// ---- topology ---------------------------------------------------------------------------------
+
+std::size_t World::particleCount() const {
+  std::size_t n = 0;
+  for (const Cloth& cloth : cloths_) n += cloth.state.position.size();
+  return n;
+}
+
+void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>& splits) {
+  Cloth& cloth = cloths_[c];
+  const std::size_t n = cloth.state.position.size();
+  held_[c].resize(n, 0);
+  // A copy of a held particle stays in the same finger's grip.
+  for (const ParticleSplit& split : splits) {
+    if (!held_[c][split.original]) continue;
+    for (Finger& f : fingers_) {
+      for (std::size_t g = 0; g < f.grips.size(); ++g) {
+        if (f.grips[g].cloth != static_cast<int>(c) || f.grips[g].particle != split.original) continue;
+        f.grips.push_back({static_cast<int>(c), split.copy, f.grips[g].offset});
+        held_[c][split.copy] = 1;
+        break;
+      }
+    }
+  }
+  SolverScratch& scratch = scratch_[c];
+  grow(scratch.acceleration, n);
+  grow(scratch.trialPosition, n);
+  grow(scratch.trialVelocity, n);
+  grow(scratch.sumPosition, n);
+  grow(scratch.sumVelocity, n);
+  cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
+  // A tether may not reach across a tear.
+  std::erase_if(scratch.tethers, [&](const SolverScratch::Tether& t) { return cloth.piece[t.particle] != cloth.piece[t.pin]; });
+  topologyVersion_ = nextTopologyVersion();
+}
+
+void World::tear() {
+  std::vector<ParticleSplit> splits;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    splits.clear();
+    const std::size_t budget = static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
+    if (!topology::tear(cloths_[c], settings_.tearing.threshold, budget, splits)) continue;
+    afterTopologyChange(c, splits);
+  }
+}
+
+int World::cut(Vec3 a, Vec3 b, Vec3 depth) {
+  if (!finite(a) || !finite(b) || !finite(depth)) return 0;
+  int opened = 0;
+  std::vector<ParticleSplit> splits;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    splits.clear();
+    const std::size_t budget = static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
+    if (!topology::cut(cloths_[c], a, b, depth, budget, splits)) continue;
+    afterTopologyChange(c, splits);
+    ++opened;
+  }
+  return opened;
+}
+
+void World::setTearing(const TearSettings& tearing) {
+  validateTearing(tearing);
+  settings_.tearing = tearing;
+  buildPipeline();
+}
+
+// ---- cloths while running ----------------------------------------------------------------------
+
+int World::addCloth(const ClothSettings& settings) {
+  validateCloth(settings, settings_.solver.model);
+  require(static_cast<long long>(particleCount()) +
+                  static_cast<long long>(settings.lattice.columns) * settings.lattice.rows <=
+              kMaxParticles,
+          "too many particles");
+  cloths_.push_back(makeCloth(settings, settings_.solver.model));
+  settings_.cloths.push_back(settings);
+  const std::size_t c = cloths_.size() - 1;
+  scratch_.emplace_back();
+  held_.emplace_back(cloths_[c].state.position.size(), 0);
+  buildTethers(c);
+  buildPipeline();
+  if (historyStarted_) {
+    // It starts at rest where it was made, whatever happened to the world before.
+    startHistory(c);
+  }
+  topologyVersion_ = nextTopologyVersion();
+  return static_cast<int>(c);
+}
+
+void World::removeCloth(int index) {
+  if (index < 0 || static_cast<std::size_t>(index) >= cloths_.size()) return;
+  for (Finger& f : fingers_) {
+    std::erase_if(f.grips, [&](const FingerGrip& g) { return g.cloth == index; });
+    for (FingerGrip& g : f.grips) {
+      if (g.cloth > index) --g.cloth;
+    }
+  }
+  cloths_.erase(cloths_.begin() + index);
+  settings_.cloths.erase(settings_.cloths.begin() + index);
+  scratch_.erase(scratch_.begin() + index);
+  held_.erase(held_.begin() + index);
+  lastGood_.clear();
+  buildPipeline();
+  topologyVersion_ = nextTopologyVersion();
 }
 
 }  // namespace drape::sim

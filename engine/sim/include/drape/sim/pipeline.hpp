@@ -12,6 +12,8 @@
 namespace drape::sim {
 
 enum class Stage : std::uint8_t {
+  // every model, first in each substep
+  fingers,  // carry the particles fingers hold along the fingers' paths
   // position model, once per substep
   windPressure,        // aerodynamic force on triangles -> per-particle acceleration
   verletIntegrate,     // x' = x + (x - x_prev) decay + a h^2
@@ -30,6 +32,7 @@ enum class Stage : std::uint8_t {
   collideForces,  // contacts with velocity response
   // every model, once per step
   guard,  // stop at the first non-finite or runaway position
+  tear,   // split the mesh where a stretch constraint is past the tearing threshold
 };
 
 std::string_view name(Stage stage);

@@ -94,6 +94,13 @@ struct SelfCollisionSettings {
   Real maxTravel = 0.5;  // fraction of `distance` a particle may move per substep (no crossing)
 };
 
+// Tearing (the seed's node splitting): a stretch constraint longer than `threshold` times its rest
+// length at the end of a step splits the mesh there. Tunable while the world runs.
+struct TearSettings {
+  bool enabled = false;
+  Real threshold = 1.5;  // > 1
+};
+
 struct WorldSettings {
   SolverSettings solver;
   Vec3 gravity{0.0, -9.81, 0.0};  // m/s^2
@@ -101,6 +108,7 @@ struct WorldSettings {
   std::vector<ClothSettings> cloths;
   std::vector<ColliderSettings> colliders;
   SelfCollisionSettings selfCollision;
+  TearSettings tearing;
 };
 
 // Limits the engine accepts; the scene layer reports them to the user.

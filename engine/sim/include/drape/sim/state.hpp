@@ -16,7 +16,9 @@ struct ParticleState {
   std::vector<Vec3> position;          // m
   std::vector<Vec3> previousPosition;  // m, position one substep ago (Verlet's velocity-less memory)
   std::vector<Vec3> velocity;          // m/s, force model only; empty in the position model
-  std::vector<Real> inverseMass;       // 1/kg; 0 for a pinned particle, which nothing moves
+  std::vector<Real> inverseMass;       // 1/kg; 0 for a pinned or held particle, which no force or constraint moves
+  std::vector<Real> mass;              // kg, of every particle, pinned or not
+  std::vector<std::uint8_t> pinned;    // 1: pinned (stays where it is until unpinned)
 };
 
 }  // namespace drape::sim

@@ -14,6 +14,7 @@
 #include "drape/sim/pipeline.hpp"
 #include "drape/sim/settings.hpp"
 #include "drape/sim/state.hpp"
+#include "drape/sim/topology.hpp"
 
 namespace drape::sim {
 
@@ -21,7 +22,25 @@ struct Cloth {
   ClothRest rest;
   ParticleState state;
   ClothSettings settings;
-  Real particleMass = 0.0;  // kg, mass of every unpinned particle
+  Topology topology;                // built the first time the cloth tears or is cut
+  std::vector<std::uint32_t> piece;  // per particle: which connected piece it belongs to
+  std::uint32_t pieceCount = 1;
+};
+
+// A finger holding particles (the seed's sticky finger). Each held particle keeps its offset from
+// the finger and moves rigidly with it; the world moves it, no force or constraint does.
+struct FingerGrip {
+  int cloth;
+  ParticleIndex particle;
+  Vec3 offset;  // m, from the finger
+};
+
+struct Finger {
+  int id = 0;            // the caller's name for it
+  Vec3 position{0.0};    // m, where it is now
+  Vec3 target{0.0};      // m, where the next step takes it (along a straight line)
+  Real radius = 0.0;     // m
+  std::vector<FingerGrip> grips;
 };
 
 struct Divergence {
@@ -56,11 +75,55 @@ class World {
   // Velocity of a particle, m/s: stored in the force model, (x - x_prev) / h in the position model.
   Vec3 velocity(int cloth, ParticleIndex particle) const;
 
+  // Fingers. Any number may be down at once, each under the caller's id.
+  // press: every particle within `radius` of `point` on the piece of the particle nearest to it
+  // sticks to the finger, except particles another finger already holds (the first finger keeps
+  // them). Returns how many it holds (a finger that touches nothing is still down), or -1 if the id
+  // is already down or the numbers are not finite and positive.
+  int pressFinger(int id, Vec3 point, Real radius);
+  // As press, at the point of the ray (origin + t direction, t > 0) nearest to the first particle
+  // the ray passes within `radius` of. Returns that point, or nothing if the ray meets no cloth (the
+  // finger is then not down).
+  std::optional<Vec3> pressFingerAlongRay(int id, Vec3 origin, Vec3 direction, Real radius);
+  // The next step carries the finger (and what it holds) in a straight line to `target`. False if
+  // the id is not down or the target is not finite.
+  bool moveFinger(int id, Vec3 target);
+  // Lets go: the particles fly on with the finger's last velocity (a flick throws the cloth).
+  bool releaseFinger(int id);
+  // Lifts the finger but leaves what it held pinned where it is. Returns how many particles were
+  // pinned, or -1 if the id is not down.
+  int pinFinger(int id);
+  // Frees the pinned particles within `radius` of `point` (not those a finger holds). Returns how many.
+  int unpin(Vec3 point, Real radius);
+  const std::vector<Finger>& fingers() const { return fingers_; }
+  const Finger* finger(int id) const;
+
+  // Cuts every cloth along the surface swept by the segment a-b moved along `depth` (a swipe seen
+  // along the view direction). Returns how many cloths it opened.
+  int cut(Vec3 a, Vec3 b, Vec3 depth);
+  // Tearing can be switched and tuned while the world runs. Throws std::invalid_argument on a
+  // threshold that is not a finite number above 1.
+  void setTearing(const TearSettings& tearing);
+
+  // Adds a cloth while the world runs (it starts at rest) and returns its index; throws
+  // std::invalid_argument like the constructor. Removing a cloth drops what fingers held of it.
+  int addCloth(const ClothSettings& cloth);
+  void removeCloth(int index);
+
  private:
+  void buildPipeline();
+  void buildTethers(std::size_t cloth);
+  void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits);
+  void moveFingers(Real h);
+  void tear();
+  void grab(Finger& finger, std::size_t cloth, ParticleIndex nearest);
+  std::size_t particleCount() const;
   void runStage(Stage stage);
   void startHistory();
+  void startHistory(std::size_t cloth);
   void moveColliders();
   std::optional<Divergence> findBadParticle() const;
+  Finger* findFinger(int id);
 
   WorldSettings settings_;
   std::vector<Cloth> cloths_;
@@ -77,6 +140,8 @@ class World {
     std::vector<Vec3> position, previousPosition, velocity;
   };
   std::vector<Snapshot> lastGood_;  // what the current step changes, as it was before it
+  std::vector<Finger> fingers_;
+  std::vector<std::vector<std::uint8_t>> held_;  // per cloth and particle: 1 while a finger holds it
 };
 
 }  // namespace drape::sim

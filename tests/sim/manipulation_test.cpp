@@ -1,0 +1,304 @@
+// Fingers, tearing and cutting at the engine level: what a hand does to the cloth.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+
+#include <glm/geometric.hpp>
+
+#include "drape/sim/world.hpp"
+#include "world_builder.hpp"
+
+namespace drape::sim {
+namespace {
+
+// An n x n sheet of 1 m lying flat at y = 0 from (0, 0, 0) to (1, 0, 1), weightless unless asked.
+WorldSettings flatSheet(int n, Vec3 gravity = Vec3{0.0}) {
+  WorldSettings world;
+  world.gravity = gravity;
+  world.solver.iterations = 20;
+  world.solver.substeps = 2;
+  ClothSettings cloth;
+  cloth.lattice = {n, n, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz};
+  cloth.mass = 1.0;
+  world.cloths.push_back(cloth);
+  return world;
+}
+
+Real totalMass(const World& world) {
+  Real mass = 0.0;
+  for (const Cloth& cloth : world.cloths()) mass = std::accumulate(cloth.state.mass.begin(), cloth.state.mass.end(), mass);
+  return mass;
+}
+
+std::vector<ParticleIndex> held(const World& world, int id) {
+  std::vector<ParticleIndex> particles;
+  for (const FingerGrip& grip : world.finger(id)->grips) particles.push_back(grip.particle);
+  return particles;
+}
+
+// The longest edge of any triangle relative to its rest length.
+Real worstTriangleStretch(const Cloth& cloth) {
+  Real worst = 0.0;
+  for (const glm::uvec3& t : cloth.rest.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const ParticleIndex a = t[k], b = t[(k + 1) % 3];
+      const Real rest = glm::length(cloth.rest.restPositions[b] - cloth.rest.restPositions[a]);
+      worst = std::max(worst, glm::length(cloth.state.position[b] - cloth.state.position[a]) / rest);
+    }
+  }
+  return worst;
+}
+
+TEST(Finger, HoldsEveryParticleWithinItsRadiusAndCarriesThemRigidly) {
+  World world(flatSheet(11));
+  // Spacing 0.1: a radius of 0.15 around (0.5, 0, 0.5) takes the centre and its 8 neighbours, plus
+  // the 4 two apart along the axes are at 0.2 (outside).
+  ASSERT_EQ(world.pressFinger(1, Vec3{0.5, 0.0, 0.5}, 0.15), 9);
+  const std::vector<ParticleIndex> grabbed = held(world, 1);
+  std::vector<Vec3> before;
+  for (ParticleIndex p : grabbed) before.push_back(world.cloths()[0].state.position[p]);
+  const Vec3 move{0.3, 0.2, -0.1};
+  world.moveFinger(1, Vec3{0.5, 0.0, 0.5} + move);
+  world.step();
+  for (std::size_t k = 0; k < grabbed.size(); ++k) {
+    const Vec3 now = world.cloths()[0].state.position[grabbed[k]];
+    EXPECT_NEAR(glm::length(now - (before[k] + move)), 0.0, 1e-12);
+  }
+  // The rest of the sheet followed through the constraints.
+  const ParticleIndex corner = world.cloths()[0].rest.index(10, 10);
+  EXPECT_GT(world.cloths()[0].state.position[corner].y, 1e-3);
+  EXPECT_TRUE(world.hasStage(Stage::fingers));
+  world.releaseFinger(1);
+  EXPECT_FALSE(world.hasStage(Stage::fingers));
+}
+
+TEST(Finger, ReleasedParticlesKeepTheFingersVelocity) {
+  // One free particle, no gravity: carried at 2 m/s, then let go, it flies on at 2 m/s.
+  WorldSettings settings = test::singleParticle(Vec3{0.0});
+  settings.gravity = Vec3{0.0};
+  settings.solver.substeps = 3;
+  World world(settings);
+  ASSERT_EQ(world.pressFinger(7, Vec3{0.0}, 0.01), 1);
+  const Real dt = settings.solver.dt;
+  const Vec3 velocity{2.0, 0.0, -1.0};
+  for (int k = 1; k <= 5; ++k) {
+    world.moveFinger(7, velocity * (dt * k));
+    world.step();
+  }
+  world.releaseFinger(7);
+  const Vec3 released = world.cloths()[0].state.position[0];
+  EXPECT_NEAR(glm::length(released - velocity * (dt * 5)), 0.0, 1e-12);
+  world.run(10);
+  EXPECT_NEAR(glm::length(world.cloths()[0].state.position[0] - (released + velocity * (dt * 10))), 0.0, 1e-9);
+  EXPECT_NEAR(glm::length(world.velocity(0, 0) - velocity), 0.0, 1e-9);
+}
+
+TEST(Finger, ReleasedParticlesKeepTheFingersVelocityInTheForceModelToo) {
+  WorldSettings settings = test::singleParticle(Vec3{0.0});
+  settings.gravity = Vec3{0.0};
+  settings.solver.model = Model::force;
+  settings.solver.integrator = Integrator::rk4;
+  settings.cloths[0].material(ConstraintKind::stretch) = {100.0, 0.0};
+  World world(settings);
+  ASSERT_EQ(world.pressFinger(1, Vec3{0.0}, 0.01), 1);
+  const Vec3 velocity{0.0, 1.5, 0.0};
+  for (int k = 1; k <= 4; ++k) {
+    world.moveFinger(1, velocity * (settings.solver.dt * k));
+    world.step();
+  }
+  world.releaseFinger(1);
+  world.run(6);
+  EXPECT_NEAR(glm::length(world.cloths()[0].state.position[0] - velocity * (settings.solver.dt * 10)), 0.0, 1e-9);
+}
+
+TEST(Finger, AParticleUnderTwoFingersBelongsToTheFirst) {
+  World world(flatSheet(11));
+  const int first = world.pressFinger(1, Vec3{0.4, 0.0, 0.5}, 0.15);
+  const int second = world.pressFinger(2, Vec3{0.6, 0.0, 0.5}, 0.15);
+  EXPECT_EQ(first, 9);
+  EXPECT_EQ(second, 6);  // the column at x = 0.5 went to finger 1
+  std::vector<ParticleIndex> a = held(world, 1), b = held(world, 2);
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  std::vector<ParticleIndex> both;
+  std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(both));
+  EXPECT_TRUE(both.empty());
+  EXPECT_EQ(world.pressFinger(1, Vec3{0.0}, 0.1), -1);  // already down
+  EXPECT_FALSE(world.moveFinger(3, Vec3{0.0}));          // never down
+  EXPECT_FALSE(world.releaseFinger(3));
+}
+
+TEST(Finger, PressAlongARayTakesTheFirstClothItMeets) {
+  WorldSettings settings = flatSheet(11);
+  ClothSettings upper = settings.cloths[0];
+  upper.lattice.origin = Vec3{0.0, 0.5, 0.0};
+  settings.cloths.push_back(upper);
+  World world(settings);
+  const auto point = world.pressFingerAlongRay(1, Vec3{0.5, 3.0, 0.5}, Vec3{0.0, -1.0, 0.0}, 0.05);
+  ASSERT_TRUE(point);
+  EXPECT_NEAR(point->y, 0.5, 1e-12);
+  for (const FingerGrip& grip : world.finger(1)->grips) EXPECT_EQ(grip.cloth, 1);
+  EXPECT_FALSE(world.pressFingerAlongRay(2, Vec3{5.0, 3.0, 0.5}, Vec3{0.0, -1.0, 0.0}, 0.05));
+  EXPECT_EQ(world.finger(2), nullptr);
+}
+
+TEST(Finger, PinnedParticlesStayAfterTheFingerLiftsAndFallWhenUnpinned) {
+  World world(flatSheet(11, Vec3{0.0, -9.81, 0.0}));
+  const Vec3 corner{1.0, 0.0, 1.0};
+  ASSERT_GT(world.pressFinger(1, corner, 0.05), 0);
+  for (int step = 1; step <= 30; ++step) {
+    world.moveFinger(1, corner + Vec3{0.0, step / 30.0, 0.0});
+    world.step();
+  }
+  ASSERT_EQ(world.pinFinger(1), 1);
+  EXPECT_EQ(world.finger(1), nullptr);
+  const ParticleIndex p = world.cloths()[0].rest.index(10, 10);
+  // The rest of the sheet swings from it, below it, never farther than the sheet's diagonal.
+  const Vec3 pin = corner + Vec3{0.0, 1.0, 0.0};
+  Real lowest = 1.0, farthest = 0.0;
+  for (int step = 0; step < 120; ++step) {
+    world.step();
+    for (const Vec3& x : world.cloths()[0].state.position) {
+      lowest = std::min(lowest, x.y);
+      farthest = std::max(farthest, glm::length(x - pin));
+    }
+    EXPECT_NEAR(glm::length(world.cloths()[0].state.position[p] - pin), 0.0, 1e-12);
+  }
+  EXPECT_LT(lowest, -0.3);
+  EXPECT_LT(farthest, std::sqrt(2.0) * 1.02);
+  EXPECT_EQ(world.unpin(corner + Vec3{0.0, 1.0, 0.0}, 0.01), 1);
+  world.run(30);
+  EXPECT_LT(world.cloths()[0].state.position[p].y, 0.9);
+}
+
+TEST(Finger, CarriesAPinAndLeavesItWhereItWasPut) {
+  WorldSettings settings = flatSheet(5, Vec3{0.0, -9.81, 0.0});
+  settings.cloths[0].pins = {{0, 0, std::nullopt}};
+  World world(settings);
+  ASSERT_EQ(world.pressFinger(1, Vec3{0.0}, 0.01), 1);
+  world.moveFinger(1, Vec3{-0.5, 0.5, 0.0});
+  world.run(10);
+  world.releaseFinger(1);
+  world.run(20);
+  EXPECT_NEAR(glm::length(world.cloths()[0].state.position[0] - Vec3{-0.5, 0.5, 0.0}), 0.0, 1e-12);
+}
+
+// A sheet pinned along x = 0, pulled by a finger along its far edge until it tears.
+World pulledApart(Real threshold, int steps) {
+  WorldSettings settings = flatSheet(11);
+  settings.tearing = {true, threshold};
+  for (int row = 0; row < 11; ++row) settings.cloths[0].pins.push_back({0, row, std::nullopt});
+  World world(settings);
+  for (int row = 0; row < 11; ++row) world.pressFinger(row, Vec3{1.0, 0.0, 0.1 * row}, 0.01);
+  for (int step = 1; step <= steps; ++step) {
+    for (int row = 0; row < 11; ++row) world.moveFinger(row, Vec3{1.0 + 0.02 * step, 0.0, 0.1 * row});
+    world.step();
+  }
+  return world;
+}
+
+TEST(Tearing, PullingApartSplitsTheSheetIntoPiecesWithoutTrianglesAcrossTheGap) {
+  const World world = pulledApart(1.3, 60);
+  const Cloth& cloth = world.cloths()[0];
+  EXPECT_GE(cloth.pieceCount, 2u);
+  EXPECT_GT(cloth.state.position.size(), 121u);  // particles were split, not deleted
+  EXPECT_NEAR(totalMass(world), 1.0, 1e-12);
+  // The pinned edge and the pulled edge are on different pieces, and no triangle spans the gap.
+  EXPECT_NE(cloth.piece[cloth.rest.index(0, 5)], cloth.piece[cloth.rest.index(10, 5)]);
+  EXPECT_LT(worstTriangleStretch(cloth), 1.3 * 1.3);
+  for (const auto& list : cloth.rest.constraints) {
+    for (const DistanceConstraint& c : list) EXPECT_EQ(cloth.piece[c.a], cloth.piece[c.b]);
+  }
+}
+
+TEST(Tearing, IsDeterministicAndOffByDefault) {
+  const World a = pulledApart(1.3, 40), b = pulledApart(1.3, 40);
+  ASSERT_EQ(a.cloths()[0].state.position.size(), b.cloths()[0].state.position.size());
+  EXPECT_EQ(a.cloths()[0].state.position, b.cloths()[0].state.position);
+  EXPECT_EQ(a.cloths()[0].rest.triangles, b.cloths()[0].rest.triangles);
+
+  WorldSettings settings = flatSheet(5);
+  EXPECT_FALSE(World(settings).hasStage(Stage::tear));
+  World world(settings);
+  world.setTearing({true, 1.2});
+  EXPECT_TRUE(world.hasStage(Stage::tear));
+  EXPECT_THROW(world.setTearing({true, 0.9}), std::invalid_argument);
+}
+
+TEST(Tearing, AChainBreaksAtItsMostStretchedLink) {
+  WorldSettings settings;
+  settings.gravity = Vec3{0.0};
+  settings.tearing = {true, 1.5};
+  settings.cloths.push_back(test::chainCloth(6, 1, 1.0, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz, {1.0, 0.0}));
+  settings.cloths[0].pins.push_back({0, 0, std::nullopt});
+  World world(settings);
+  world.pressFinger(1, Vec3{1.0, 0.0, 0.0}, 0.01);
+  // Pulled slowly: the first link past 1.5 times its length breaks, and the chain lets go.
+  int step = 0;
+  while (world.cloths()[0].pieceCount == 1 && step < 200) {
+    world.moveFinger(1, Vec3{1.0 + 0.01 * ++step, 0.0, 0.0});
+    world.step();
+  }
+  EXPECT_EQ(world.cloths()[0].pieceCount, 2u);
+  EXPECT_EQ(world.cloths()[0].rest.of(ConstraintKind::stretch).size(), 4u);
+}
+
+TEST(Cutting, ASwipeAcrossTheSheetMakesTwoPiecesThatMoveApart) {
+  World world(flatSheet(21));
+  const std::uint64_t version = world.topologyVersion();
+  // From outside to outside across the middle, seen from above.
+  ASSERT_EQ(world.cut(Vec3{-0.2, 0.0, 0.52}, Vec3{1.2, 0.0, 0.48}, Vec3{0.0, -1.0, 0.0}), 1);
+  const Cloth& cloth = world.cloths()[0];
+  EXPECT_NE(world.topologyVersion(), version);
+  EXPECT_EQ(cloth.pieceCount, 2u);
+  EXPECT_NEAR(totalMass(world), 1.0, 1e-12);
+  // Pick up the near half: the far half stays on the table.
+  ASSERT_GT(world.pressFinger(1, Vec3{0.5, 0.0, 0.9}, 0.3), 0);
+  world.moveFinger(1, Vec3{0.5, 0.5, 0.9});
+  world.run(20);
+  Real farHighest = -1.0, nearLowest = 1.0;
+  for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+    const Vec3 x = cloth.state.position[i];
+    if (cloth.piece[i] == cloth.piece[cloth.rest.index(0, 0)]) farHighest = std::max(farHighest, x.y);
+    else nearLowest = std::min(nearLowest, x.y);
+  }
+  EXPECT_LT(farHighest, 1e-9);
+  EXPECT_GT(nearLowest, 0.1);
+}
+
+TEST(Cutting, ASwipeThatStopsInsideLeavesASlitNotTwoPieces) {
+  World world(flatSheet(21));
+  world.cut(Vec3{-0.2, 0.0, 0.51}, Vec3{0.5, 0.0, 0.51}, Vec3{0.0, -1.0, 0.0});
+  const Cloth& cloth = world.cloths()[0];
+  EXPECT_EQ(cloth.pieceCount, 1u);
+  EXPECT_GT(cloth.state.position.size(), 441u);
+  EXPECT_NEAR(totalMass(world), 1.0, 1e-12);
+  // A swipe that misses the cloth changes nothing.
+  const std::uint64_t version = world.topologyVersion();
+  EXPECT_EQ(world.cut(Vec3{2.0, 0.0, 0.0}, Vec3{3.0, 0.0, 1.0}, Vec3{0.0, -1.0, 0.0}), 0);
+  EXPECT_EQ(world.topologyVersion(), version);
+}
+
+TEST(Cloths, CanBeAddedAndRemovedWhileTheWorldRuns) {
+  World world(flatSheet(5, Vec3{0.0, -9.81, 0.0}));
+  world.run(3);
+  ClothSettings extra = world.settings().cloths[0];
+  extra.lattice.origin = Vec3{0.0, 1.0, 0.0};
+  const std::uint64_t version = world.topologyVersion();
+  EXPECT_EQ(world.addCloth(extra), 1);
+  EXPECT_NE(world.topologyVersion(), version);
+  EXPECT_LT(glm::length(world.velocity(1, 0)), 0.1);  // starts at rest (up to the exact start g h / 2)
+  world.pressFinger(1, Vec3{0.0, 1.0, 0.0}, 0.01);
+  world.run(3);
+  world.removeCloth(1);
+  EXPECT_EQ(world.cloths().size(), 1u);
+  EXPECT_TRUE(world.finger(1)->grips.empty());
+  world.run(3);
+  ClothSettings bad = extra;
+  bad.mass = -1.0;
+  EXPECT_THROW(world.addCloth(bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace drape::sim
