@@ -527,7 +527,7 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   if (options.showPins) {
     for (const sim::Cloth& cloth : world.cloths()) {
       for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-        if (cloth.state.inverseMass[i] == 0.0) {
+        if (cloth.state.pinned[i]) {  // pinned, not merely held by a finger
           r.overlayScratch.push_back({glm::vec3(cloth.state.position[i]), glm::vec4(0.95f, 0.85f, 0.25f, 1.0f)});
         }
       }

@@ -329,6 +329,10 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     }
     return severed;
   };
+  // One crack step per neighbourhood and pass: a constraint next to particles this pass already
+  // severed around waits for the next pass (and its own strain then), so neighbouring cracks do not
+  // cut out slivers and islands between them.
+  std::vector<std::uint8_t> near(rest.particleCount(), 0);
   for (const auto& [ratio, j] : strained) {
     ConstraintTemplate& x = topology.templates[topology.source[static_cast<std::size_t>(ConstraintKind::stretch)][j]];
     if (x.link == ConstraintTemplate::Link::free) {
@@ -337,8 +341,16 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
       continue;
     }
     const DistanceConstraint& c = stretch[j];
+    if (near[c.a] || near[c.b]) continue;
+    const std::size_t before = touched.size();
     const Vec3 pull = rest.restPositions[c.b] - rest.restPositions[c.a];
     if (severAround(c.a, pull) || severAround(c.b, -pull)) changed = true;
+    // Mark the triangles around every particle on the new crack.
+    for (std::size_t k = before; k < touched.size(); ++k) {
+      for (auto t = incidence.begin(touched[k]); t != incidence.end(touched[k]); ++t) {
+        for (int corner = 0; corner < 3; ++corner) near[rest.triangles[*t][corner]] = 1;
+      }
+    }
   }
   if (!changed) return false;
   splitParticles(cloth, std::move(touched), particleBudget, splits);

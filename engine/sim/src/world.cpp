@@ -25,8 +25,14 @@ void require(bool condition, const std::string& what) {
   if (!condition) throw std::invalid_argument(what);
 }
 
+// Particles a lattice cloth will have; a drawn cloth's are known once it is built.
+long long latticeParticles(const ClothSettings& cloth) {
+  return cloth.outline ? 0 : static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
+}
+
 void validateCloth(const ClothSettings& cloth, Model model) {
-  const long long clothParticles = static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
+  if (cloth.outline) require(cloth.pins.empty(), "a drawn cloth has no lattice to pin by column and row");
+  const long long clothParticles = cloth.outline ? 1 : latticeParticles(cloth);
   require(clothParticles <= kMaxParticles, "too many particles");
   require(finite(cloth.mass) && cloth.mass > 0.0, "cloth mass must be positive");
   require(std::isfinite(static_cast<Real>(clothParticles) / cloth.mass) &&
@@ -41,6 +47,12 @@ void validateCloth(const ClothSettings& cloth, Model model) {
       require(m.stiffness <= 1.0 && m.damping <= 1.0, "position-model stiffness and damping must be in 0..1");
     }
     require(finite(m.compliance) && m.compliance >= 0.0, "constraint compliance must be finite and >= 0");
+  }
+  if (cloth.outline) require(cloth.masses.empty(), "a drawn cloth has no lattice to weigh particles by column and row");
+  for (const ParticleMass& m : cloth.masses) {
+    require(m.column >= 0 && m.column < cloth.lattice.columns && m.row >= 0 && m.row < cloth.lattice.rows,
+            "particle mass outside the lattice");
+    require(finite(m.mass) && m.mass > 0.0 && std::isfinite(1.0 / m.mass), "particle mass must be positive");
   }
   for (const Pin& pin : cloth.pins) {
     require(pin.column >= 0 && pin.column < cloth.lattice.columns && pin.row >= 0 && pin.row < cloth.lattice.rows,
@@ -69,7 +81,7 @@ void validate(const WorldSettings& s) {
   long long particles = 0;
   for (const ClothSettings& cloth : s.cloths) {
     validateCloth(cloth, solver.model);
-    particles += static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
+    particles += latticeParticles(cloth);
   }
   require(particles <= kMaxParticles, "too many particles");
   const SelfCollisionSettings& self = s.selfCollision;
@@ -114,15 +126,29 @@ Stage integratorStage(Integrator integrator) {
 Cloth makeCloth(const ClothSettings& settings, Model model) {
   Cloth cloth;
   cloth.settings = settings;
-  cloth.rest = buildLattice(settings.lattice, {used(settings.material(ConstraintKind::stretch)),
-                                               used(settings.material(ConstraintKind::shear)),
-                                               used(settings.material(ConstraintKind::bend))});
+  const ConstraintSelection selection{used(settings.material(ConstraintKind::stretch)),
+                                      used(settings.material(ConstraintKind::shear)),
+                                      used(settings.material(ConstraintKind::bend))};
+  cloth.rest = settings.outline ? buildFromOutline(*settings.outline, selection).rest
+                                : buildLattice(settings.lattice, selection);
   const std::size_t n = cloth.rest.particleCount();
-  const Real particleMass = settings.mass / static_cast<Real>(n);
   ParticleState& s = cloth.state;
   s.position = cloth.rest.restPositions;
-  s.mass.assign(n, particleMass);
-  s.inverseMass.assign(n, 1.0 / particleMass);
+  s.mass.assign(n, settings.mass / static_cast<Real>(n));
+  if (settings.outline) {
+    // By area: a third of each triangle's area to each of its corners, so the border is lighter.
+    std::vector<Real> area(n, 0.0);
+    Real total = 0.0;
+    for (const glm::uvec3& t : cloth.rest.triangles) {
+      const Real a = 0.5 * glm::length(glm::cross(s.position[t[1]] - s.position[t[0]], s.position[t[2]] - s.position[t[0]]));
+      for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
+      total += a;
+    }
+    for (std::size_t i = 0; i < n; ++i) s.mass[i] = settings.mass * area[i] / total;
+  }
+  for (const ParticleMass& m : settings.masses) s.mass[cloth.rest.index(m.column, m.row)] = m.mass;
+  s.inverseMass.resize(n);
+  for (std::size_t i = 0; i < n; ++i) s.inverseMass[i] = 1.0 / s.mass[i];
   s.pinned.assign(n, 0);
   for (const Pin& pin : settings.pins) {
     const ParticleIndex p = cloth.rest.index(pin.column, pin.row);
@@ -159,6 +185,7 @@ World::World(WorldSettings settings) : settings_(std::move(settings)), topologyV
   for (const ClothSettings& clothSettings : settings_.cloths) {
     cloths_.push_back(makeCloth(clothSettings, settings_.solver.model));
   }
+  require(particleCount() <= static_cast<std::size_t>(kMaxParticles), "too many particles");
   scratch_.resize(cloths_.size());
   held_.resize(cloths_.size());
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
@@ -603,11 +630,10 @@ void World::setTearing(const TearSettings& tearing) {
 
 int World::addCloth(const ClothSettings& settings) {
   validateCloth(settings, settings_.solver.model);
-  require(static_cast<long long>(particleCount()) +
-                  static_cast<long long>(settings.lattice.columns) * settings.lattice.rows <=
-              kMaxParticles,
+  Cloth cloth = makeCloth(settings, settings_.solver.model);
+  require(particleCount() + cloth.state.position.size() <= static_cast<std::size_t>(kMaxParticles),
           "too many particles");
-  cloths_.push_back(makeCloth(settings, settings_.solver.model));
+  cloths_.push_back(std::move(cloth));
   settings_.cloths.push_back(settings);
   const std::size_t c = cloths_.size() - 1;
   scratch_.emplace_back();

@@ -8,6 +8,7 @@
 
 #include "drape/sim/cloth.hpp"
 #include "drape/sim/collider.hpp"
+#include "drape/sim/outline.hpp"
 #include "drape/sim/types.hpp"
 
 namespace drape::sim {
@@ -73,13 +74,24 @@ struct Pin {
   std::optional<Vec3> position;  // m; absent: held where the lattice puts it
 };
 
+// One particle of a lattice with a mass of its own (a weight sewn into the hem).
+struct ParticleMass {
+  int column = 0;
+  int row = 0;
+  Real mass = 1.0;  // kg
+};
+
 struct ClothSettings {
   LatticeSpec lattice;
-  Real mass = 1.0;            // kg, spread evenly over the particles
+  // A drawn cloth: the outline, filled with a lattice (see outline.hpp), instead of `lattice`.
+  // Its mass is spread by area: each particle carries a third of its triangles' area.
+  std::optional<OutlineSpec> outline;
+  Real mass = 1.0;            // kg, spread evenly over the particles of a lattice
   Vec3 initialVelocity{0.0};  // m/s, of every unpinned particle at the start
   Real thickness = 0.005;     // m, how close a particle comes to a collider's surface
   std::array<KindMaterial, kConstraintKindCount> materials{};
   std::vector<Pin> pins;
+  std::vector<ParticleMass> masses;  // lattice only: these particles weigh this much instead
 
   KindMaterial& material(ConstraintKind kind) { return materials[static_cast<std::size_t>(kind)]; }
   const KindMaterial& material(ConstraintKind kind) const { return materials[static_cast<std::size_t>(kind)]; }

@@ -1,0 +1,66 @@
+// A cloth cut to an outline: the stroke a finger drew on the table, filled with the seed's lattice.
+//
+// The table is the x-z plane; a point of the stroke is (x, z) in metres. "Counter-clockwise seen from +y" is defined
+// by the same sign that makes the lattice's triangle normals point +y: points p0, p1, p2 are counter-clockwise when
+// cross(p1 - p0, p2 - p0).y > 0 with p = (x, 0, z), i.e. (p1.z - p0.z) (p2.x - p0.x) - (p1.x - p0.x) (p2.z - p0.z) > 0.
+// (Looking down from +y with x to the right, +z points down the page.)
+//
+// How a stroke becomes a rest mesh:
+//  1. Clean. A non-finite point is an error. Points are held as integers on a grid of 1/4096 spacing, so that every
+//     later geometric decision is exact and cannot contradict another (the loop moves by at most 0.07% of a spacing).
+//     Points closer than spacing/4 to the previous kept point are dropped, the stroke is simplified with
+//     Douglas-Peucker (tolerance spacing/4) and closed: the last point joins the first.
+//  2. Untangle. Walking along the closed stroke, whenever it crosses or touches its own path so far, the loop it has
+//     just closed is cut off and the walk continues from the crossing (a figure-eight is cut at its waist). Every loop
+//     cut off is simple; the one enclosing the largest area is kept, and tookLargestLoop says the stroke was split
+//     into more than one loop with area. A figure-eight keeps its larger lobe; a circle drawn with an overshoot past
+//     its start keeps the circle. Edges shorter than spacing/3 (left by crossings) are then removed where that keeps
+//     the loop simple.
+//  3. Orient. The loop is made counter-clockwise seen from +y.
+//  4. Fill. The lattice (spacing apart along x and z, with a node at the stroke's smallest x and z, and the
+//     lattice's own diagonal in each cell) is clipped exactly against the loop: triangles inside stay as they are,
+//     triangles the loop crosses become the part of them inside the loop, triangulated. So the mesh covers the loop
+//     exactly, with every corner of the loop a particle and every boundary edge on the loop. Slivers are then
+//     removed by collapsing short edges, each collapse checked to keep every triangle counter-clockwise and no worse
+//     than a quality floor: a lattice node closer than spacing/2 to the loop moves onto it, and boundary particles
+//     closer than 0.4 spacing along the loop merge (never removing a corner of the loop). A boundary particle then
+//     takes the lattice position (column, row) of the nearest unclaimed node outside the loop within spacing/2, so
+//     that the border joins in the lattice's constraints.
+//  5. Constrain, as the seed's lattice does, by lattice position: every triangle edge between diagonal neighbours is
+//     shear, the other diagonal of a whole cell (both of its triangles present) is shear too, every other triangle
+//     edge is stretch (on the border, edges between particles without a lattice position are stretch as well), and
+//     bend joins particles two apart along a row or column whose middle particle and both stretch edges exist.
+//     Rest lengths are measured on the rest positions. Border triangles without a lattice bend across them get no
+//     extra bending constraint (kept simple; the lattice bends reach the border wherever the border particles hold
+//     lattice positions).
+#pragma once
+
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "drape/sim/cloth.hpp"
+#include "drape/sim/types.hpp"
+
+namespace drape::sim {
+
+struct OutlineSpec {
+  std::vector<glm::dvec2> points;  // the stroke, in the table plane: (x, z) in metres, as drawn (not closed)
+  Real spacing = 0.05;             // m, lattice spacing of the fill, > 0
+  Real height = 0.0;               // m, y of the cloth (it lies flat in the x-z plane)
+};
+
+struct OutlineCloth {
+  ClothRest rest;                // columns = rows = 0 (not a lattice); triangles counter-clockwise seen from +y
+  std::vector<glm::dvec2> loop;  // the simple closed loop used, counter-clockwise seen from +y (first point not repeated)
+  bool tookLargestLoop = false;  // true when the stroke crossed itself and the largest simple loop was kept
+};
+
+// Builds the rest mesh of a cloth cut to the outline. Throws std::invalid_argument with a one-line message when the
+// outline cannot make a cloth: spacing or height not finite (spacing not positive), a non-finite point, fewer than 3
+// distinct points, no enclosed area (collinear points), smaller than one cell (area under spacing^2), wider than
+// 2^17 spacings, so tangled that untangling would take too long, or more particles than kMaxParticles (estimated from
+// area and perimeter before anything is allocated; the message says how many).
+OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selection = {});
+
+}  // namespace drape::sim

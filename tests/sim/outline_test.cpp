@@ -1,0 +1,483 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "drape/sim/cloth.hpp"
+#include "drape/sim/outline.hpp"
+#include "drape/sim/settings.hpp"
+
+namespace drape::sim {
+namespace {
+
+using Points = std::vector<glm::dvec2>;
+
+// cross(b - a, c - a).y for points (x, 0, z) given as (x, z): positive is counter-clockwise seen from +y.
+double turn(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) { return (b.y - a.y) * (c.x - a.x) - (b.x - a.x) * (c.y - a.y); }
+
+double signedArea(const Points& loop) {
+  double sum = 0.0;
+  for (std::size_t i = 1; i + 1 < loop.size(); ++i) sum += turn(loop[0], loop[i], loop[i + 1]);
+  return 0.5 * sum;
+}
+
+double perimeter(const Points& loop) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < loop.size(); ++i) sum += glm::length(loop[(i + 1) % loop.size()] - loop[i]);
+  return sum;
+}
+
+glm::dvec2 flat(const Vec3& p) { return {p.x, p.z}; }
+
+double distanceToSegment(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
+  const glm::dvec2 ab = b - a;
+  const double t = std::clamp(glm::dot(p - a, ab) / glm::dot(ab, ab), 0.0, 1.0);
+  return glm::length(p - (a + t * ab));
+}
+
+double distanceToLoop(glm::dvec2 p, const Points& loop) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < loop.size(); ++i) best = std::min(best, distanceToSegment(p, loop[i], loop[(i + 1) % loop.size()]));
+  return best;
+}
+
+// Proper crossing or touching of two closed segments (for the loop's simplicity).
+bool segmentsMeet(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, glm::dvec2 d) {
+  const double o1 = turn(a, b, c), o2 = turn(a, b, d), o3 = turn(c, d, a), o4 = turn(c, d, b);
+  if ((o1 > 0 && o2 > 0) || (o1 < 0 && o2 < 0) || (o3 > 0 && o4 > 0) || (o3 < 0 && o4 < 0)) return false;
+  if (o1 != 0 || o2 != 0 || o3 != 0 || o4 != 0) return true;
+  return std::max(std::min(a.x, b.x), std::min(c.x, d.x)) <= std::min(std::max(a.x, b.x), std::max(c.x, d.x)) &&
+         std::max(std::min(a.y, b.y), std::min(c.y, d.y)) <= std::min(std::max(a.y, b.y), std::max(c.y, d.y));
+}
+
+bool isSimpleLoop(const Points& loop) {
+  const std::size_t n = loop.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;
+      if (segmentsMeet(loop[i], loop[i + 1], loop[j], loop[(j + 1) % n])) return false;
+    }
+  }
+  return true;
+}
+
+// Do the open interiors of two counter-clockwise triangles overlap by more than `slack`? Separating axes: the
+// triangles are apart if some edge of either has the whole other triangle on its outer side.
+bool interiorsOverlap(const std::array<glm::dvec2, 3>& a, const std::array<glm::dvec2, 3>& b, double slack) {
+  for (const auto* t : {&a, &b}) {
+    const auto& other = t == &a ? b : a;
+    for (int e = 0; e < 3; ++e) {
+      const glm::dvec2 p = (*t)[e], q = (*t)[(e + 1) % 3];
+      const double lengthPQ = glm::length(q - p);
+      bool separated = true;
+      for (const glm::dvec2& r : other) {
+        if (turn(p, q, r) / lengthPQ > slack) separated = false;
+      }
+      if (separated) return false;
+    }
+  }
+  return true;
+}
+
+struct MeshReport {
+  double area = 0.0;
+  double minQuality = 1.0;
+  double minEdge = std::numeric_limits<double>::infinity();
+  std::size_t boundaryEdges = 0;
+};
+
+// Every property the builder promises, checked from the outside.
+MeshReport checkMesh(const OutlineCloth& cloth, const OutlineSpec& spec) {
+  MeshReport report;
+  const ClothRest& rest = cloth.rest;
+  const Points& loop = cloth.loop;
+  EXPECT_EQ(rest.columns, 0);
+  EXPECT_EQ(rest.rows, 0);
+  EXPECT_GE(loop.size(), 3u);
+  EXPECT_GT(signedArea(loop), 0.0) << "loop must be counter-clockwise seen from +y";
+  if (loop.size() < 400) {
+    EXPECT_TRUE(isSimpleLoop(loop));
+  }
+  EXPECT_FALSE(rest.triangles.empty());
+
+  std::vector<char> used(rest.particleCount(), 0);
+  std::map<std::pair<ParticleIndex, ParticleIndex>, int> directed;
+  for (const glm::uvec3& t : rest.triangles) {
+    const std::array<ParticleIndex, 3> v{t.x, t.y, t.z};
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_LT(v[c], rest.particleCount());
+      used[v[c]] = 1;
+      ++directed[{v[c], v[(c + 1) % 3]}];
+    }
+    const glm::dvec2 a = flat(rest.restPositions[t.x]), b = flat(rest.restPositions[t.y]), c = flat(rest.restPositions[t.z]);
+    const Vec3 normal = glm::cross(rest.restPositions[t.y] - rest.restPositions[t.x],
+                                   rest.restPositions[t.z] - rest.restPositions[t.x]);
+    EXPECT_GT(normal.y, 0.0) << "triangle must face +y";
+    report.area += 0.5 * turn(a, b, c);
+    const double squares = glm::dot(b - a, b - a) + glm::dot(c - b, c - b) + glm::dot(a - c, a - c);
+    report.minQuality = std::min(report.minQuality, 2.0 * std::sqrt(3.0) * turn(a, b, c) / squares);
+  }
+  for (std::size_t p = 0; p < rest.particleCount(); ++p) {
+    EXPECT_TRUE(used[p]) << "particle " << p << " belongs to no triangle";
+    EXPECT_EQ(rest.restPositions[p].y, spec.height);
+  }
+  // Each directed edge once (consistent winding); an edge without its twin is on the boundary, and must lie on the
+  // loop: both ends and the middle within 1e-9 of it.
+  double boundaryLength = 0.0;
+  for (const auto& [edge, count] : directed) {
+    EXPECT_EQ(count, 1) << "edge used twice in the same direction: triangles overlap";
+    const glm::dvec2 a = flat(rest.restPositions[edge.first]), b = flat(rest.restPositions[edge.second]);
+    report.minEdge = std::min(report.minEdge, glm::length(b - a));
+    if (directed.count({edge.second, edge.first}) != 0) continue;
+    ++report.boundaryEdges;
+    boundaryLength += glm::length(b - a);
+    EXPECT_LT(distanceToLoop(a, loop), 1e-9);
+    EXPECT_LT(distanceToLoop(b, loop), 1e-9);
+    EXPECT_LT(distanceToLoop(0.5 * (a + b), loop), 1e-9) << "boundary edge leaves the loop";
+  }
+  // The boundary runs once around the loop, and the triangles cover it exactly.
+  EXPECT_NEAR(boundaryLength, perimeter(loop), 1e-9 * std::max(1.0, perimeter(loop)));
+  EXPECT_NEAR(report.area, signedArea(loop), 1e-9 * std::max(1.0, signedArea(loop)));
+  // Every corner of the loop is a particle.
+  for (const glm::dvec2& corner : loop) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Vec3& p : rest.restPositions) nearest = std::min(nearest, glm::length(flat(p) - corner));
+    EXPECT_LT(nearest, 1e-9);
+  }
+  // No two triangles overlap (beyond rounding), checked directly on nearby pairs.
+  if (rest.triangles.size() < 20000) {
+    const double cell = spec.spacing;
+    std::map<std::pair<long long, long long>, std::vector<std::size_t>> buckets;
+    std::vector<std::array<glm::dvec2, 3>> corners;
+    for (const glm::uvec3& t : rest.triangles) {
+      corners.push_back({flat(rest.restPositions[t.x]), flat(rest.restPositions[t.y]), flat(rest.restPositions[t.z])});
+      const auto& c = corners.back();
+      const glm::dvec2 low = glm::min(glm::min(c[0], c[1]), c[2]), high = glm::max(glm::max(c[0], c[1]), c[2]);
+      for (auto x = static_cast<long long>(std::floor(low.x / cell)); x <= static_cast<long long>(std::floor(high.x / cell)); ++x) {
+        for (auto z = static_cast<long long>(std::floor(low.y / cell)); z <= static_cast<long long>(std::floor(high.y / cell)); ++z) {
+          buckets[{x, z}].push_back(corners.size() - 1);
+        }
+      }
+    }
+    std::set<std::pair<std::size_t, std::size_t>> overlapping;
+    for (const auto& [key, list] : buckets) {
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        for (std::size_t j = i + 1; j < list.size(); ++j) {
+          if (interiorsOverlap(corners[list[i]], corners[list[j]], 1e-9 * spec.spacing)) {
+            overlapping.insert({list[i], list[j]});
+          }
+        }
+      }
+    }
+    EXPECT_TRUE(overlapping.empty()) << overlapping.size() << " overlapping triangle pairs";
+  }
+  // Constraints: no pair twice (over all kinds), never a particle with itself, rest length the rest distance.
+  std::set<std::pair<ParticleIndex, ParticleIndex>> pairs;
+  for (const ConstraintKind kind : kConstraintKinds) {
+    for (const DistanceConstraint& c : rest.of(kind)) {
+      EXPECT_NE(c.a, c.b);
+      EXPECT_TRUE(pairs.insert({std::min(c.a, c.b), std::max(c.a, c.b)}).second) << "duplicate " << name(kind);
+      EXPECT_GT(c.restLength, 0.0);
+      EXPECT_NEAR(c.restLength, glm::length(rest.restPositions[c.b] - rest.restPositions[c.a]), 1e-12);
+    }
+  }
+  // Every triangle edge is held by a stretch or shear constraint.
+  for (const auto& [edge, count] : directed) {
+    EXPECT_TRUE(pairs.count({std::min(edge.first, edge.second), std::max(edge.first, edge.second)}) == 1)
+        << "triangle edge without a constraint";
+  }
+  return report;
+}
+
+Points square(double side, glm::dvec2 origin = {0.0, 0.0}) {
+  return {origin, origin + glm::dvec2(side, 0.0), origin + glm::dvec2(side, side), origin + glm::dvec2(0.0, side)};
+}
+
+Points circle(double radius, int count, glm::dvec2 centre = {0.0, 0.0}) {
+  Points points;
+  for (int i = 0; i < count; ++i) {
+    const double a = 2.0 * std::numbers::pi * i / count;
+    points.push_back(centre + radius * glm::dvec2(std::cos(a), std::sin(a)));
+  }
+  return points;
+}
+
+Points star(int arms, double outer, double inner) {
+  Points points;
+  for (int i = 0; i < 2 * arms; ++i) {
+    const double a = std::numbers::pi * i / arms;
+    points.push_back((i % 2 == 0 ? outer : inner) * glm::dvec2(std::cos(a), std::sin(a)));
+  }
+  return points;
+}
+
+std::string messageOf(const OutlineSpec& spec) {
+  try {
+    buildFromOutline(spec);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(no exception)";
+}
+
+TEST(Outline, SquareIsTheLattice) {
+  // A 1 m square at 0.1 m spacing is the 11 x 11 lattice: same particles, triangles and constraints.
+  const OutlineSpec spec{square(1.0), 0.1, 0.25};
+  const OutlineCloth cloth = buildFromOutline(spec);
+  const MeshReport report = checkMesh(cloth, spec);
+  EXPECT_FALSE(cloth.tookLargestLoop);
+  EXPECT_NEAR(report.area, 1.0, 1e-9);
+  const ClothRest lattice = buildLattice({11, 11, 1.0, 1.0, Vec3{0.0, 0.25, 0.0}, LatticePlane::xz});
+  EXPECT_EQ(cloth.rest.particleCount(), lattice.particleCount());
+  EXPECT_EQ(cloth.rest.triangles.size(), lattice.triangles.size());
+  for (const ConstraintKind kind : kConstraintKinds) {
+    EXPECT_EQ(cloth.rest.of(kind).size(), lattice.of(kind).size()) << name(kind);
+  }
+  // Every particle sits on a lattice point (to the 1/1024-spacing grid the loop is held on).
+  for (const Vec3& p : cloth.rest.restPositions) {
+    EXPECT_NEAR(p.x * 10.0, std::round(p.x * 10.0), 1e-2);
+    EXPECT_NEAR(p.z * 10.0, std::round(p.z * 10.0), 1e-2);
+  }
+}
+
+TEST(Outline, SquareOffTheLatticeStillCoversItExactly) {
+  for (const double side : {0.53, 0.77, 1.0}) {
+    const OutlineSpec spec{square(side, {0.013, -0.021}), 0.05, 0.0};
+    const OutlineCloth cloth = buildFromOutline(spec);
+    const MeshReport report = checkMesh(cloth, spec);
+    // The loop is the square held on a 1/4096-spacing grid: each corner moves by at most 2 sqrt(2) / 4096 spacings.
+    EXPECT_NEAR(report.area, side * side, 4.0 * side * 2.0 * std::sqrt(2.0) / 4096.0 * spec.spacing);
+    // The border rule: every inside node, plus about one particle per spacing of border.
+    const double cells = side / spec.spacing;
+    EXPECT_GE(static_cast<double>(cloth.rest.particleCount()), cells * cells);
+    EXPECT_LE(static_cast<double>(cloth.rest.particleCount()), (cells + 3.0) * (cells + 3.0));
+  }
+}
+
+TEST(Outline, CircleAreaApproachesPiRSquared) {
+  const double radius = 0.5;
+  for (const double spacing : {0.1, 0.05, 0.02}) {
+    const OutlineSpec spec{circle(radius, 720), spacing, 0.0};
+    const OutlineCloth cloth = buildFromOutline(spec);
+    const MeshReport report = checkMesh(cloth, spec);
+    const double disc = std::numbers::pi * radius * radius;
+    // The triangles cover the loop exactly; the loop is the circle simplified to within spacing / 4.
+    EXPECT_NEAR(report.area, signedArea(cloth.loop), 1e-9);
+    EXPECT_LT(disc - report.area, disc * 4.0 * (spacing / 4.0) / radius) << "spacing " << spacing;
+    EXPECT_LE(report.area, disc);
+  }
+}
+
+TEST(Outline, LShapeAndStarWork) {
+  const Points lShape{{0.0, 0.0}, {1.0, 0.0}, {1.0, 0.4}, {0.4, 0.4}, {0.4, 1.0}, {0.0, 1.0}};
+  for (const Points& points : {lShape, star(5, 0.5, 0.2), star(7, 0.6, 0.35)}) {
+    const OutlineSpec spec{points, 0.05, 0.1};
+    const OutlineCloth cloth = buildFromOutline(spec);
+    const MeshReport report = checkMesh(cloth, spec);
+    EXPECT_NEAR(report.area, std::abs(signedArea(points)), 1e-3);
+    EXPECT_FALSE(cloth.tookLargestLoop);
+    EXPECT_GT(report.minQuality, 0.05);
+  }
+}
+
+TEST(Outline, ClockwiseStrokeGivesTheSameCloth) {
+  Points points = star(5, 0.5, 0.2);
+  const OutlineCloth forward = buildFromOutline({points, 0.05, 0.0});
+  std::reverse(points.begin(), points.end());
+  const OutlineCloth backward = buildFromOutline({points, 0.05, 0.0});
+  EXPECT_NEAR(signedArea(forward.loop), signedArea(backward.loop), 1e-9);
+  EXPECT_GT(signedArea(backward.loop), 0.0);
+  EXPECT_EQ(forward.rest.particleCount(), backward.rest.particleCount());
+}
+
+TEST(Outline, FigureEightKeepsTheLargerLobe) {
+  // Two circles drawn as one stroke crossing at the origin: radius 0.5 on the right, 0.25 on the left.
+  Points points;
+  for (int i = 0; i < 200; ++i) {
+    const double a = std::numbers::pi - 2.0 * std::numbers::pi * i / 200.0;
+    points.push_back(glm::dvec2(0.5, 0.0) + 0.5 * glm::dvec2(std::cos(a), std::sin(a)));
+  }
+  for (int i = 0; i < 100; ++i) {
+    const double a = 2.0 * std::numbers::pi * i / 100.0;
+    points.push_back(glm::dvec2(-0.25, 0.0) + 0.25 * glm::dvec2(std::cos(a), std::sin(a)));
+  }
+  const OutlineSpec spec{points, 0.05, 0.0};
+  const OutlineCloth cloth = buildFromOutline(spec);
+  checkMesh(cloth, spec);
+  EXPECT_TRUE(cloth.tookLargestLoop);
+  EXPECT_NEAR(signedArea(cloth.loop), std::numbers::pi * 0.25, 0.05);
+  for (const glm::dvec2& p : cloth.loop) EXPECT_GT(p.x, -1e-3);
+}
+
+TEST(Outline, OvershootingTheStartKeepsTheCircle) {
+  Points points = circle(0.4, 100);
+  for (int i = 0; i < 10; ++i) points.push_back(points[static_cast<std::size_t>(i)] + glm::dvec2(0.0, 0.02));
+  const OutlineSpec spec{points, 0.05, 0.0};
+  const OutlineCloth cloth = buildFromOutline(spec);
+  checkMesh(cloth, spec);
+  EXPECT_NEAR(signedArea(cloth.loop), std::numbers::pi * 0.16, 0.03);
+}
+
+TEST(Outline, DuplicatesAndJitterAreHarmless) {
+  Points repeated;
+  for (const glm::dvec2& p : square(0.6)) {
+    for (int k = 0; k < 5; ++k) repeated.push_back(p);
+  }
+  const OutlineSpec clean{repeated, 0.05, 0.0};
+  const OutlineCloth fromRepeated = buildFromOutline(clean);
+  checkMesh(fromRepeated, clean);
+  EXPECT_EQ(fromRepeated.rest.particleCount(), buildFromOutline({square(0.6), 0.05, 0.0}).rest.particleCount());
+
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> jitter(-0.004, 0.004);
+  Points shaky;
+  for (const glm::dvec2& p : circle(0.45, 3000)) shaky.push_back(p + glm::dvec2(jitter(random), jitter(random)));
+  const OutlineSpec spec{shaky, 0.05, 0.0};
+  const OutlineCloth cloth = buildFromOutline(spec);
+  checkMesh(cloth, spec);
+  EXPECT_NEAR(signedArea(cloth.loop), std::numbers::pi * 0.45 * 0.45, 0.05);
+}
+
+TEST(Outline, ConstraintsFollowTheLatticeInside) {
+  const OutlineSpec spec{circle(0.5, 360), 0.05, 0.0};
+  const OutlineCloth cloth = buildFromOutline(spec);
+  checkMesh(cloth, spec);
+  // Deep inside, stretch is the spacing, shear its diagonal and bend twice the spacing.
+  std::size_t lattice = 0;
+  for (const ConstraintKind kind : kConstraintKinds) {
+    const double expected = kind == ConstraintKind::stretch ? 0.05 : kind == ConstraintKind::shear ? 0.05 * std::sqrt(2.0) : 0.1;
+    for (const DistanceConstraint& c : cloth.rest.of(kind)) {
+      const glm::dvec2 middle = 0.5 * (flat(cloth.rest.restPositions[c.a]) + flat(cloth.rest.restPositions[c.b]));
+      if (glm::length(middle) > 0.35) continue;
+      EXPECT_NEAR(c.restLength, expected, 1e-9) << name(kind);
+      ++lattice;
+    }
+  }
+  EXPECT_GT(lattice, 500u);
+  // Unused kinds are not generated.
+  const OutlineCloth stretchOnly = buildFromOutline(spec, {true, false, false});
+  EXPECT_FALSE(stretchOnly.rest.of(ConstraintKind::stretch).empty());
+  EXPECT_TRUE(stretchOnly.rest.of(ConstraintKind::shear).empty());
+  EXPECT_TRUE(stretchOnly.rest.of(ConstraintKind::bend).empty());
+}
+
+TEST(Outline, IsDeterministic) {
+  const OutlineSpec spec{star(6, 0.5, 0.3), 0.03, 0.0};
+  const OutlineCloth a = buildFromOutline(spec), b = buildFromOutline(spec);
+  EXPECT_EQ(a.rest.restPositions, b.rest.restPositions);
+  EXPECT_EQ(a.rest.triangles, b.rest.triangles);
+  EXPECT_EQ(a.loop, b.loop);
+}
+
+TEST(Outline, BadOutlinesSayWhy) {
+  const auto expectMessage = [](const OutlineSpec& spec, const std::string& part) {
+    const std::string message = messageOf(spec);
+    EXPECT_NE(message.find(part), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos);
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  expectMessage({{{0, 0}, {1, 0}}, 0.05, 0.0}, "fewer than 3 distinct points");
+  expectMessage({{{0, 0}, {1, 0}, {0, 0}, {1, 0}, {1, 0}}, 0.05, 0.0}, "fewer than 3 distinct points");
+  expectMessage({{}, 0.05, 0.0}, "fewer than 3 distinct points");
+  expectMessage({{{0, 0}, {1, 1}, {2, 2}, {0.5, 0.5}}, 0.05, 0.0}, "no area");
+  expectMessage({{{0, 0}, {1, 0}, {2, 0}, {0.5, 0}}, 0.05, 0.0}, "no area");
+  expectMessage({square(1.0), 0.0, 0.0}, "spacing must be positive");
+  expectMessage({square(1.0), -0.1, 0.0}, "spacing must be positive");
+  expectMessage({square(1.0), nan, 0.0}, "spacing must be positive");
+  expectMessage({square(1.0), inf, 0.0}, "spacing must be positive");
+  expectMessage({square(1.0), 0.05, nan}, "height must be finite");
+  expectMessage({{{0, 0}, {1, nan}, {1, 1}, {0, 1}}, 0.05, 0.0}, "non-finite point");
+  expectMessage({{{0, 0}, {inf, 0}, {1, 1}, {0, 1}}, 0.05, 0.0}, "non-finite point");
+  expectMessage({square(0.04), 0.05, 0.0}, "less than one cell");
+  expectMessage({square(0.01), 0.05, 0.0}, "less than one cell");
+  // 10 m x 10 m at 5 mm: about 2001^2 = 4 million particles.
+  const std::string tooMany = messageOf({square(10.0), 0.005, 0.0});
+  EXPECT_NE(tooMany.find("particles, more than the limit of " + std::to_string(kMaxParticles)), std::string::npos)
+      << tooMany;
+  EXPECT_NE(tooMany.find("about 4004001 particles"), std::string::npos) << tooMany;
+  expectMessage({square(1e300), 0.05, 0.0}, "spacings");
+  expectMessage({{{-1e308, -1e308}, {1e308, -1e308}, {0, 1e308}}, 0.05, 0.0}, "spacings");
+}
+
+TEST(Outline, NeverCrashesOnHostileInput) {
+  // Huge and tiny coordinates, huge point counts, scribbles: a cloth or a std::invalid_argument, quickly.
+  const auto survives = [](const OutlineSpec& spec) {
+    try {
+      const OutlineCloth cloth = buildFromOutline(spec);
+      EXPECT_FALSE(cloth.rest.triangles.empty());
+    } catch (const std::invalid_argument&) {
+    }
+  };
+  survives({square(1.0, {1e9, -1e9}), 0.05, 0.0});
+  survives({{{1e300, 1e300}, {1e300 + 1e285, 1e300}, {1e300, 1e300 + 1e285}}, 1e284, 0.0});
+  survives({square(1e-300), 1e-301, 0.0});
+  survives({square(1.0), 1e-300, 0.0});
+  survives({square(1.0), 1e300, 0.0});
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> anywhere(0.0, 1.0);
+  Points scribble;
+  for (int i = 0; i < 100000; ++i) scribble.push_back({anywhere(random), anywhere(random)});
+  survives({scribble, 0.05, 0.0});
+  survives({scribble, 0.001, 0.0});
+}
+
+TEST(Outline, AMillionPointsAreFine) {
+  const auto start = std::chrono::steady_clock::now();
+  const OutlineSpec spec{circle(0.5, 1'000'000), 0.05, 0.0};
+  const OutlineCloth cloth = buildFromOutline(spec);
+  checkMesh(cloth, spec);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 10.0);  // generous: sanitizers slow this down many times
+}
+
+TEST(Outline, SquareMetreAtOneCentimetreIsFast) {
+  const OutlineSpec spec{circle(std::sqrt(1.0 / std::numbers::pi), 400), 0.01, 0.0};
+  const auto start = std::chrono::steady_clock::now();
+  const OutlineCloth cloth = buildFromOutline(spec);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GT(cloth.rest.particleCount(), 9000u);
+  EXPECT_LT(seconds, 5.0);  // well under a second in an optimised build; sanitizers are slower
+  RecordProperty("seconds", std::to_string(seconds));
+}
+
+// Random star-shaped and random-walk outlines at random spacings: every invariant, every time.
+TEST(Outline, RandomOutlinesKeepEveryPromise) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 60; ++trial) {
+    Points points;
+    const int count = 3 + static_cast<int>(unit(random) * 40);
+    for (int i = 0; i < count; ++i) {
+      const double a = 2.0 * std::numbers::pi * (i + 0.8 * unit(random)) / count;
+      const double r = 0.1 + 0.5 * unit(random);
+      points.push_back(glm::dvec2(0.3 * unit(random), 0.0) + r * glm::dvec2(std::cos(a), std::sin(a)));
+    }
+    const OutlineSpec spec{points, 0.02 + 0.08 * unit(random), 0.0};
+    try {
+      const OutlineCloth cloth = buildFromOutline(spec);
+      checkMesh(cloth, spec);
+    } catch (const std::invalid_argument& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.find("internal"), std::string::npos) << message;
+    }
+    if (HasFailure()) {
+      ADD_FAILURE() << "trial " << trial;
+      return;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace drape::sim
