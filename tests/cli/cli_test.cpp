@@ -231,7 +231,23 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"MissingObj", R"({"colliders": [{"type": "mesh", "file": "missing.obj"}]})", "",
                  "bad.json: colliders.0.file: cannot use the OBJ file"},
         BadInput{"SameOutputTwice", nullptr, "--out s2.json --out ./s2.json", "s2.json: named as an output twice"},
-        BadInput{"InvalidUtf8", nullptr, "--set \"solver.model=$(printf '\\377')\"", "solver.model: expected one of"}),
+        BadInput{"InvalidUtf8", nullptr, "--set \"solver.model=$(printf '\\377')\"", "solver.model: expected one of"},
+        BadInput{"OutlineOfTwoPoints", R"({"cloths": [{"outline": {"points": [[0, 0], [1, 0]]}}]})", "",
+                 "bad.json: cloths.0.outline: "},
+        BadInput{"OutlineOnALine", R"({"cloths": [{"outline": {"points": [[0, 0], [1, 0], [2, 0]]}}]})", "",
+                 "bad.json: cloths.0.outline: "},
+        BadInput{"OutlineSmallerThanACell",
+                 R"({"cloths": [{"outline": {"points": [[0, 0], [0.01, 0], [0, 0.01]], "spacing": 0.1}}]})", "",
+                 "bad.json: cloths.0.outline: "},
+        BadInput{"OutlineTooBig",
+                 R"({"cloths": [{"outline": {"points": [[0, 0], [100, 0], [100, 100], [0, 100]], "spacing": 0.01}}]})",
+                 "", "bad.json: cloths.0.outline: "},
+        BadInput{"OutlineAndGrid", R"({"cloths": [{"grid": {}, "outline": {"points": [[0, 0], [1, 0], [0, 1]]}}]})",
+                 "", "bad.json: cloths.0.grid: expected either \"grid\" or \"outline\""},
+        BadInput{"OutlinePointNotAPair", R"({"cloths": [{"outline": {"points": [[0, 0], [1, 0], [0, 1, 2]]}}]})", "",
+                 "bad.json: cloths.0.outline.points.2: expected [x, z]"},
+        BadInput{"TearingAtRestLength", R"({"tearing": {"threshold": 1}})", "",
+                 "bad.json: tearing.threshold: expected a number > 1"}),
     [](const auto& testInfo) { return std::string(testInfo.param.name); });
 
 TEST_F(Cli, RenderWritesAPngOfTheRequestedSize) {
@@ -336,3 +352,93 @@ TEST_F(Cli, NoSubcommandIsBadInputAndHelpIsNot) {
 }
 
 }  // namespace
+
+// Gesture scripts through the real binary: replay, warnings for events it skips, errors for bad files.
+TEST_F(Cli, ReplayPlaysAGestureAndWritesTheState) {
+  const fs::path state = file("state.json");
+  const Result result =
+      run("replay desk-tear '" + std::string(DRAPE_ASSET_DIR) + "/gestures/tear.json' --out '" + state.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(result.err.empty()) << result.err;
+  EXPECT_NE(result.out.find("desk-tear: 210 steps"), std::string::npos) << result.out;
+  const json document = json::parse(read(state));
+  // The torn cloth has more particles than its 24 x 24 lattice: split, not deleted.
+  EXPECT_GT(document["cloths"][0]["positions"].size(), 576u);
+}
+
+TEST_F(Cli, ReplaySkipsEventsItCannotHonourWithAWarningEach) {
+  const fs::path gesture = write("g.json", R"({"events": [
+    {"time": 0, "type": "up", "finger": 3},
+    {"time": 0.1, "type": "down", "finger": 1, "at": [0, 1, 0]},
+    {"time": 0.1, "type": "down", "finger": 1, "at": [0, 1, 0]}]})");
+  const fs::path sceneFile = write("s.json", scene().dump());
+  const Result result = run("replay '" + sceneFile.string() + "' '" + gesture.string() + "' --quiet");
+  EXPECT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NE(result.err.find("drape-cli: warning: " + gesture.string() +
+                            ": event 0 (up at 0.000 s): finger 3 is not down; skipped\n"),
+            std::string::npos)
+      << result.err;
+  EXPECT_NE(result.err.find(": event 2 (down at 0.100 s): finger 1 is already down; skipped"), std::string::npos);
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 2) << result.err;
+}
+
+struct BadGesture {
+  const char* name;
+  const char* text;
+  const char* fragment;
+};
+
+void PrintTo(const BadGesture& c, std::ostream* os) { *os << c.name; }
+
+class CliBadGesture : public Cli, public ::testing::WithParamInterface<BadGesture> {};
+
+TEST_P(CliBadGesture, ExitsTwoWithOneLineNamingTheKey) {
+  const BadGesture& c = GetParam();
+  const fs::path gesture = write("g.json", c.text);
+  const fs::path sceneFile = write("s.json", scene().dump());
+  const fs::path state = file("state.json");
+  const Result result =
+      run("replay '" + sceneFile.string() + "' '" + gesture.string() + "' --out '" + state.string() + "'");
+  expectOneLineError(result, 2, c.fragment);
+  EXPECT_FALSE(fs::exists(state));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CliBadGesture,
+    ::testing::Values(
+        BadGesture{"Malformed", R"({"events": [)", "g.json: malformed JSON"},
+        BadGesture{"UnknownKey", R"({"event": []})", "g.json: event: unknown key"},
+        BadGesture{"UnknownType", R"({"events": [{"time": 0, "type": "tap", "finger": 1}]})",
+                   "g.json: events.0.type: expected one of"},
+        BadGesture{"MissingTime", R"({"events": [{"type": "up", "finger": 1}]})", "g.json: events.0.time: expected"},
+        BadGesture{"NegativeTime", R"({"events": [{"time": -1, "type": "up", "finger": 1}]})",
+                   "g.json: events.0.time: expected a number >= 0"},
+        BadGesture{"OutOfOrder",
+                   R"({"events": [{"time": 1, "type": "up", "finger": 1}, {"time": 0.5, "type": "up", "finger": 1}]})",
+                   "g.json: events.1.time: expected a time no earlier than the event before"},
+        BadGesture{"MissingFinger", R"({"events": [{"time": 0, "type": "down", "at": [0, 0, 0]}]})",
+                   "g.json: events.0.finger: expected the finger's id"},
+        BadGesture{"NegativeFinger", R"({"events": [{"time": 0, "type": "up", "finger": -2}]})",
+                   "g.json: events.0.finger: expected an integer from 0"},
+        BadGesture{"NoPointer", R"({"events": [{"time": 0, "type": "down", "finger": 1}]})",
+                   "g.json: events.0.at: expected exactly one of"},
+        BadGesture{"TwoPointers",
+                   R"({"events": [{"time": 0, "type": "down", "finger": 1, "at": [0, 0, 0], "screen": [0, 0]}]})",
+                   "g.json: events.0.screen: expected exactly one of"},
+        BadGesture{"ScreenWithoutCamera", R"({"events": [{"time": 0, "type": "down", "finger": 1, "screen": [0.5, 0.5]}]})",
+                   "g.json: events.0.screen: expected a \"camera\""},
+        BadGesture{"ScreenNotAPair", R"({"camera": {}, "events": [{"time": 0, "type": "move", "finger": 1, "screen": [0.5]}]})",
+                   "g.json: events.0.screen: expected [x, y]"},
+        BadGesture{"ZeroRadius", R"({"finger": {"radius": 0}})", "g.json: finger.radius: expected a number > 0"},
+        BadGesture{"BadPlane", R"({"finger": {"plane": "wall"}})", "g.json: finger.plane: expected one of"},
+        BadGesture{"BadMode", R"({"events": [{"time": 0, "type": "mode", "mode": "paint"}]})",
+                   "g.json: events.0.mode: expected one of"},
+        BadGesture{"LiftWithoutHeight", R"({"events": [{"time": 0, "type": "lift", "finger": 1}]})",
+                   "g.json: events.0.height: expected"},
+        BadGesture{"PointerOutOfRange", R"({"events": [{"time": 0, "type": "down", "finger": 1, "at": [1e9, 0, 0]}]})",
+                   "g.json: events.0.at: expected"}),
+    [](const auto& testInfo) { return std::string(testInfo.param.name); });
+
+TEST_F(Cli, AMissingGestureFileIsBadInput) {
+  expectOneLineError(run("replay hang " + file("nowhere.json").string()), 2, "nowhere.json: cannot open the gesture script");
+}

@@ -36,6 +36,12 @@ std::size_t countParticles(const sim::World& world) {
   return count;
 }
 
+unsigned countPieces(const sim::World& world) {
+  unsigned count = 0;
+  for (const sim::Cloth& cloth : world.cloths()) count += cloth.pieceCount;
+  return count;
+}
+
 enum class OutputKind { state, mesh };
 
 OutputKind outputKind(const std::string& file) {
@@ -113,9 +119,10 @@ int validate(const SceneArguments& arguments) {
 int run(const RunArguments& arguments) {
   try {
     const scene::Scene scene = loadScene(arguments.input);
-    sim::World world = makeWorld(scene);
+    Playback playback(scene, arguments.gesture);
+    sim::World& world = playback.world();
     rejectBadOutputs(arguments);  // before running, not after
-    const std::int64_t steps = stepCount(scene, arguments.steps, arguments.seconds);
+    const std::int64_t steps = stepCount(scene, arguments.steps, arguments.seconds, playback.script());
 
     std::optional<TraceTarget> target;
     std::ostringstream trace;
@@ -128,9 +135,13 @@ int run(const RunArguments& arguments) {
 
     const auto start = std::chrono::steady_clock::now();
     for (std::int64_t i = 0; i < steps; ++i) {
-      if (world.step() == sim::StepStatus::diverged) return reportDivergence(scene, world);
+      if (playback.step() == sim::StepStatus::diverged) {
+        playback.printReports();
+        return reportDivergence(scene, world);
+      }
       if (target) appendTraceRow(trace, world, *target);
     }
+    playback.printReports();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     std::vector<scene::OutputFile> files;
@@ -148,10 +159,10 @@ int run(const RunArguments& arguments) {
       const sim::StrainStats strain = sim::structuralStrain(world);
       const sim::Energy energy = sim::energy(world);
       std::printf(
-          "%s: %lld steps (%.3f s simulated) in %.3f s; %zu particles; structural strain max %.2f %%, mean %.3f %%; "
-          "energy %.4g J\n",
-          scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds, countParticles(world),
-          100.0 * strain.max, 100.0 * strain.mean, energy.total());
+          "%s: %lld steps (%.3f s simulated) in %.3f s; %zu cloth(s), %zu particles, %u piece(s); structural strain "
+          "max %.2f %%, mean %.3f %%; energy %.4g J\n",
+          scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds, world.cloths().size(),
+          countParticles(world), countPieces(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
       for (const scene::OutputFile& file : files) std::printf("wrote %s\n", file.path.c_str());
     }
     return kExitOk;

@@ -29,6 +29,7 @@ struct RunArguments {
   std::optional<std::string> trace;  // "column,row"
   int traceCloth = 0;
   std::optional<std::string> traceOut;
+  std::optional<std::string> gesture;  // a gesture script played while running
   bool quiet = false;
 };
 
@@ -42,6 +43,7 @@ struct RenderArguments {
   std::optional<std::int64_t> every;  // a picture every K steps ...
   std::optional<std::string> outDir;  // ... into this folder
   bool strain = false;                // strain colour map
+  std::optional<std::string> gesture;  // a gesture script played while running
   bool quiet = false;
 };
 

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "drape/scene/error.hpp"
+#include "drape/scene/gesture.hpp"
 
 namespace drape::cli {
 
@@ -25,16 +26,33 @@ sim::World makeWorld(const scene::Scene& scene) {
   }
 }
 
-std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> steps, std::optional<double> seconds) {
-  const double wanted = steps ? static_cast<double>(*steps)
-                              : std::ceil((seconds ? *seconds : scene.duration) / scene.world.solver.dt - 1e-9);
+std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> steps, std::optional<double> seconds,
+                       const interact::GestureScript* script) {
+  const double length = seconds ? *seconds : script ? script->length() : scene.duration;
+  const double wanted = steps ? static_cast<double>(*steps) : std::ceil(length / scene.world.solver.dt - 1e-9);
   if (!(wanted <= kMaxSteps)) {
     char count[64];
     std::snprintf(count, sizeof count, "%.0f", wanted);
-    throw scene::InputError(scene.source + ": " + (seconds ? "--time" : "duration") + " / solver.dt asks for " + count +
+    throw scene::InputError(scene.source + ": " + (seconds ? "--time" : script ? "the gesture's length" : "duration") +
+                            " / solver.dt asks for " + count +
                             " steps, more than the limit of " + std::to_string(static_cast<long long>(kMaxSteps)));
   }
   return static_cast<std::int64_t>(wanted);
+}
+
+Playback::Playback(const scene::Scene& scene, const std::optional<std::string>& gesture) : world_(makeWorld(scene)) {
+  if (!gesture) return;
+  script_ = scene::loadGesture(*gesture);
+  interaction_ = std::make_unique<interact::Interaction>(world_);
+  replay_ = std::make_unique<interact::Replay>(world_, *interaction_, *script_);
+  interaction_->settings().material = scene::drawnClothTemplate(scene);
+}
+
+sim::StepStatus Playback::step() { return replay_ ? replay_->step() : world_.step(); }
+
+void Playback::printReports() const {
+  if (!replay_) return;
+  for (const std::string& report : replay_->reports()) std::cerr << "drape-cli: warning: " << report << "\n";
 }
 
 int reportDivergence(const scene::Scene& scene, const sim::World& world) {

@@ -5,7 +5,10 @@
 #include <optional>
 #include <string>
 
+#include <memory>
+
 #include "commands.hpp"
+#include "drape/interact/replay.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/world.hpp"
 
@@ -19,8 +22,32 @@ scene::Scene loadScene(const SceneArguments& arguments);
 // The engine validates too; its messages are a last line of defence behind the scene reader's.
 sim::World makeWorld(const scene::Scene& scene);
 
-// Steps to run: --steps, or --time / dt, or the scene's duration / dt; at most kMaxSteps.
-std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> steps, std::optional<double> seconds);
+// Steps to run: --steps, or --time / dt, or the gesture script's length / dt, or the scene's
+// duration / dt; at most kMaxSteps.
+std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> steps, std::optional<double> seconds,
+                       const interact::GestureScript* script = nullptr);
+
+// A world, and the gesture script played on it if there is one. Stays where it is made (the
+// interaction holds on to the world).
+class Playback {
+ public:
+  Playback(const scene::Scene& scene, const std::optional<std::string>& gesture);
+  Playback(const Playback&) = delete;
+  Playback& operator=(const Playback&) = delete;
+
+  sim::StepStatus step();
+  sim::World& world() { return world_; }
+  const interact::GestureScript* script() const { return script_ ? &*script_ : nullptr; }
+  const interact::Interaction* interaction() const { return interaction_.get(); }
+  // Prints the events the replay skipped, one warning line each, to stderr.
+  void printReports() const;
+
+ private:
+  sim::World world_;
+  std::optional<interact::GestureScript> script_;
+  std::unique_ptr<interact::Interaction> interaction_;
+  std::unique_ptr<interact::Replay> replay_;
+};
 
 // Prints where the world diverged and returns kExitDiverged.
 int reportDivergence(const scene::Scene& scene, const sim::World& world);

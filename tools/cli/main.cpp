@@ -52,7 +52,17 @@ int main(int argc, char** argv) {
       runCommand->add_option("--trace-out", runArguments.traceOut, "CSV file for --trace: time and position per step");
   trace->needs(traceOut);
   traceOut->needs(trace);
+  runCommand->add_option("--gesture", runArguments.gesture, "Play this gesture script while running");
   runCommand->add_flag("--quiet", runArguments.quiet, "Print nothing on success");
+
+  RunArguments replayArguments;
+  CLI::App* replayCommand = app.add_subcommand(
+      "replay", "Play a gesture script on a scene and write the final state (run with a gesture, by position)");
+  addSceneOptions(replayCommand, replayArguments.input);
+  replayCommand->add_option("gesture", replayArguments.gesture, "Gesture script (JSON)")->required();
+  addLengthOptions(replayCommand, replayArguments.steps, replayArguments.seconds);
+  replayCommand->add_option("--out", replayArguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
+  replayCommand->add_flag("--quiet", replayArguments.quiet, "Print nothing on success");
 
   RenderArguments renderArguments;
   CLI::App* renderCommand =
@@ -70,6 +80,7 @@ int main(int argc, char** argv) {
   outDir->needs(every);
   renderOut->excludes(every);
   renderCommand->add_flag("--strain", renderArguments.strain, "Colour the cloth by its stretch");
+  renderCommand->add_option("--gesture", renderArguments.gesture, "Play this gesture script (fingers are drawn)");
   renderCommand->add_flag("--quiet", renderArguments.quiet, "Print nothing on success");
 
   StabilityArguments stabilityArguments;
@@ -99,6 +110,7 @@ int main(int argc, char** argv) {
   try {
     if (*validateCommand) return validate(validateArguments);
     if (*runCommand) return run(runArguments);
+    if (*replayCommand) return run(replayArguments);
     if (*renderCommand) return render(renderArguments);
     if (*stabilityCommand) return stability(stabilityArguments);
     if (*studyCommand) return study(studyArguments);

@@ -72,12 +72,31 @@ render::Camera makeCamera(const std::string& text, const sim::World& world, doub
   return camera;
 }
 
+// Fingers down at the end of the run: a ring for a sticky finger, the path of a cut or an outline.
+render::Overlay fingerOverlay(const Playback& playback) {
+  render::Overlay overlay;
+  if (!playback.interaction()) return overlay;
+  const interact::Interaction& interaction = *playback.interaction();
+  for (const interact::TouchView& touch : interaction.touches()) {
+    const glm::vec4 colour = touch.mode == interact::Mode::cut      ? glm::vec4{0.9f, 0.1f, 0.1f, 1.0f}
+                             : touch.mode == interact::Mode::create ? glm::vec4{0.1f, 0.3f, 0.9f, 1.0f}
+                                                                    : glm::vec4{1.0f, 1.0f, 1.0f, 1.0f};
+    if (touch.mode == interact::Mode::sticky) {
+      overlay.addRing(touch.position, interaction.settings().radius, glm::dvec3{0.0, 1.0, 0.0}, colour);
+    } else {
+      overlay.addStroke(touch.stroke, colour);
+    }
+  }
+  return overlay;
+}
+
 }  // namespace
 
 int render(const RenderArguments& arguments) {
   try {
     const scene::Scene scene = loadScene(arguments.input);
-    sim::World world = makeWorld(scene);
+    Playback playback(scene, arguments.gesture);
+    sim::World& world = playback.world();
     int width = 0, height = 0;
     parseSize(arguments.size, width, height);
     const double aspect = static_cast<double>(width) / height;
@@ -87,7 +106,7 @@ int render(const RenderArguments& arguments) {
     if (arguments.out && std::filesystem::path(*arguments.out).extension() != ".png") {
       throw scene::InputError("--out " + *arguments.out + ": expected a file ending in .png");
     }
-    const std::int64_t steps = stepCount(scene, arguments.steps, arguments.seconds);
+    const std::int64_t steps = stepCount(scene, arguments.steps, arguments.seconds, playback.script());
 
     std::unique_ptr<OffscreenContext> context;
     std::unique_ptr<render::Renderer> renderer;
@@ -100,7 +119,7 @@ int render(const RenderArguments& arguments) {
     render::FrameOptions options;
     options.strainMap = arguments.strain;
     const auto picture = [&](const render::Camera& camera) {
-      renderer->render(world, camera, width, height, options);
+      renderer->render(world, camera, width, height, options, fingerOverlay(playback));
       return encodePng(renderer->readPixels(width, height), width, height);
     };
 
@@ -114,7 +133,7 @@ int render(const RenderArguments& arguments) {
       }
       const render::Camera camera = makeCamera(arguments.camera, world, aspect);
       for (std::int64_t step = 0; step <= steps; ++step) {
-        if (step > 0 && world.step() == sim::StepStatus::diverged) return reportDivergence(scene, world);
+        if (step > 0 && playback.step() == sim::StepStatus::diverged) return reportDivergence(scene, world);
         if (step % *arguments.every != 0) continue;
         char name[32];
         std::snprintf(name, sizeof name, "frame-%06lld.png", static_cast<long long>(step));
@@ -123,10 +142,13 @@ int render(const RenderArguments& arguments) {
         written.push_back(file.string());
       }
     } else {
-      if (world.run(steps) == sim::StepStatus::diverged) return reportDivergence(scene, world);
+      for (std::int64_t step = 0; step < steps; ++step) {
+        if (playback.step() == sim::StepStatus::diverged) return reportDivergence(scene, world);
+      }
       scene::writeFileAtomically(*arguments.out, picture(makeCamera(arguments.camera, world, aspect)));
       written.push_back(*arguments.out);
     }
+    playback.printReports();
     if (!arguments.quiet) {
       std::printf("%s: %lld steps, %dx%d pixels, %s\n", scene.name.c_str(), static_cast<long long>(world.stepCount()),
                   width, height, renderer->description().c_str());

@@ -2,6 +2,7 @@
 // every key not read is an error, and every error names the source and the dotted key path.
 #pragma once
 
+#include <filesystem>
 #include <initializer_list>
 #include <set>
 #include <string>
@@ -58,6 +59,9 @@ class ObjectReader {
                          const nlohmann::json* got);
 std::string describe(const nlohmann::json& value);
 std::string formatRange(const Range& range);
+// Reads a JSON file, refusing duplicate keys; `what` names it in messages ("scene file"). Throws InputError.
+nlohmann::json readJsonFile(const std::filesystem::path& file, std::string_view what);
+
 // Reads [x, y, z] at `path`.
 sim::Vec3 readVec3(const nlohmann::json& value, const std::string& path, const std::string& source, double maxAbs,
                    std::string_view unit);

@@ -1,6 +1,7 @@
 #include "drape/scene/scene.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -65,8 +66,70 @@ KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model,
   return material;
 }
 
+constexpr std::size_t kMaxOutlinePoints = 100000;
+
+// The lattice particle at `particle`: [column, row] inside the grid.
+std::pair<int, int> readParticle(ObjectReader& reader, const sim::LatticeSpec& lattice) {
+  const std::string expected =
+      "[column, row] inside the " + std::to_string(lattice.columns) + " x " + std::to_string(lattice.rows) + " grid";
+  const json* found = reader.raw("particle");
+  if (!found) reader.fail("particle", expected, nullptr);
+  const json& particle = *found;
+  const bool ok = particle.is_array() && particle.size() == 2 && particle[0].is_number_integer() &&
+                  particle[1].is_number_integer() && particle[0].get<long long>() >= 0 &&
+                  particle[0].get<long long>() < lattice.columns && particle[1].get<long long>() >= 0 &&
+                  particle[1].get<long long>() < lattice.rows;
+  if (!ok) reader.fail("particle", expected, &particle);
+  return {particle[0].get<int>(), particle[1].get<int>()};
+}
+
+// A drawn cloth: {"points": [[x, z], ...], "spacing": s, "height": y}.
+sim::OutlineSpec readOutline(ObjectReader& reader) {
+  sim::OutlineSpec outline;
+  const json& points = reader.array("points", kMaxOutlinePoints);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const json& p = points[i];
+    const bool ok = p.is_array() && p.size() == 2 && p[0].is_number() && p[1].is_number() &&
+                    std::abs(p[0].get<double>()) <= kMaxCoordinate && std::abs(p[1].get<double>()) <= kMaxCoordinate;
+    if (!ok) {
+      failAt(reader.source(), reader.pathOf("points") + "." + std::to_string(i),
+             "[x, z] in metres, each within +-" + std::to_string(static_cast<int>(kMaxCoordinate)), &p);
+    }
+    outline.points.push_back({p[0].get<double>(), p[1].get<double>()});
+  }
+  outline.spacing = reader.number("spacing", outline.spacing, {1.0e-3, 10.0, false, "m"});
+  outline.height = reader.number("height", outline.height, {-kMaxCoordinate, kMaxCoordinate, false, "m"});
+  reader.finish();
+  return outline;
+}
+
 sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long long& particleBudget) {
   sim::ClothSettings cloth;
+  if (reader.has("outline")) {
+    if (reader.has("grid")) reader.fail("grid", "either \"grid\" or \"outline\", not both", reader.raw("grid"));
+    if (reader.has("pins")) reader.fail("pins", "no pins on a drawn cloth (they name lattice columns and rows)", reader.raw("pins"));
+    ObjectReader outlineReader = reader.object("outline");
+    sim::OutlineSpec outline = readOutline(outlineReader);
+    try {
+      const sim::OutlineCloth shape = sim::buildFromOutline(outline);
+      const auto particles = static_cast<long long>(shape.rest.particleCount());
+      if (particles > particleBudget) {
+        throw InputError(reader.source() + ": " + reader.pathOf("outline") + ": " + std::to_string(particles) +
+                         " particles pass the limit of " + std::to_string(sim::kMaxParticles) +
+                         " particles over all cloths");
+      }
+      particleBudget -= particles;
+    } catch (const std::invalid_argument& error) {
+      throw InputError(reader.source() + ": " + reader.pathOf("outline") + ": " + error.what());
+    }
+    cloth.outline = std::move(outline);
+    cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
+    cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
+    cloth.thickness = reader.number("thickness", cloth.thickness, {1.0e-4, 0.1, false, "m"});
+    for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model, xpbd);
+    reader.finish();
+    return cloth;
+  }
   ObjectReader grid = reader.object("grid");
   sim::LatticeSpec& lattice = cloth.lattice;
   lattice.columns = grid.integer("columns", 2, 1, sim::kMaxLatticeSide);
@@ -92,20 +155,20 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
   const json& pins = reader.array("pins", kMaxPins);
   for (std::size_t i = 0; i < pins.size(); ++i) {
     ObjectReader pin(pins[i], reader.pathOf("pins") + "." + std::to_string(i), reader.source());
-    const std::string expected =
-        "[column, row] inside the " + std::to_string(lattice.columns) + " x " + std::to_string(lattice.rows) + " grid";
-    const json* found = pin.raw("particle");
-    if (!found) pin.fail("particle", expected, nullptr);
-    const json& particle = *found;
-    const bool ok = particle.is_array() && particle.size() == 2 && particle[0].is_number_integer() &&
-                    particle[1].is_number_integer() && particle[0].get<long long>() >= 0 &&
-                    particle[0].get<long long>() < lattice.columns && particle[1].get<long long>() >= 0 &&
-                    particle[1].get<long long>() < lattice.rows;
-    if (!ok) pin.fail("particle", expected, &particle);
-    sim::Pin result{particle[0].get<int>(), particle[1].get<int>(), std::nullopt};
+    const auto [column, row] = readParticle(pin, lattice);
+    sim::Pin result{column, row, std::nullopt};
     if (pin.has("position")) result.position = pin.vec3("position", sim::Vec3{0.0}, kMaxCoordinate, "m");
     pin.finish();
     cloth.pins.push_back(result);
+  }
+  const json& masses = reader.array("masses", kMaxPins);
+  for (std::size_t i = 0; i < masses.size(); ++i) {
+    ObjectReader weight(masses[i], reader.pathOf("masses") + "." + std::to_string(i), reader.source());
+    const auto [column, row] = readParticle(weight, lattice);
+    if (!weight.has("mass")) weight.fail("mass", "the particle's mass in kg", nullptr);
+    const double mass = weight.number("mass", 1.0, {1.0e-9, 1.0e9, false, "kg"});
+    weight.finish();
+    cloth.masses.push_back({column, row, mass});
   }
   reader.finish();
   return cloth;
@@ -156,6 +219,13 @@ Scene parseScene(const json& document, const std::string& source) {
   for (std::size_t i = 0; i < colliders.size(); ++i) {
     ObjectReader collider(colliders[i], "colliders." + std::to_string(i), source);
     world.colliders.push_back(readCollider(collider, source));
+  }
+  if (root.has("tearing")) {
+    ObjectReader tearing = root.object("tearing");
+    world.tearing.enabled = tearing.boolean("enabled", true);
+    world.tearing.threshold =
+        tearing.number("threshold", world.tearing.threshold, {1.0, 100.0, true, "ratio to the rest length"});
+    tearing.finish();
   }
   if (root.has("selfCollision")) {
     ObjectReader self = root.object("selfCollision");
@@ -212,6 +282,18 @@ void applyOverride(json& document, std::string_view assignment) {
   }
 }
 
+sim::ClothSettings drawnClothTemplate(const Scene& scene) {
+  if (!scene.world.cloths.empty()) {
+    sim::ClothSettings cloth = scene.world.cloths.front();
+    cloth.pins.clear();
+    cloth.initialVelocity = sim::Vec3{0.0};
+    return cloth;
+  }
+  sim::ClothSettings cloth;
+  for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(scene.world.solver.model, kind);
+  return cloth;
+}
+
 std::filesystem::path sceneDirectory() { return std::filesystem::path(DRAPE_ASSET_DIR) / "scenes"; }
 
 std::filesystem::path resolveScenePath(const std::string& nameOrPath) {
@@ -226,36 +308,9 @@ std::filesystem::path resolveScenePath(const std::string& nameOrPath) {
 }
 
 Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  const std::string source = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in || std::filesystem::is_directory(file)) throw InputError(source + ": cannot open the scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  json document;
-  // JSON allows a key twice in one object and keeps the last; a scene file that does so has a
-  // mistake in it, so it is refused rather than silently half-read.
-  std::vector<std::set<std::string>> keysSeen;
-  const json::parser_callback_t rejectDuplicateKeys = [&](int, json::parse_event_t event, json& parsed) {
-    if (event == json::parse_event_t::object_start) keysSeen.emplace_back();
-    if (event == json::parse_event_t::object_end && !keysSeen.empty()) keysSeen.pop_back();
-    if (event == json::parse_event_t::key && !keysSeen.empty() &&
-        !keysSeen.back().insert(parsed.get<std::string>()).second) {
-      throw InputError(source + ": key " + describe(parsed) + " appears twice in one object");
-    }
-    return true;
-  };
-  try {
-    document = json::parse(text.str(), rejectDuplicateKeys);
-  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
-    // nlohmann's message: "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
-    // nlohmann's messages start with a tag: "[json.exception.parse_error.101] parse error at line 3, ..."
-    std::string message = e.what();
-    const std::size_t tagEnd = message.find("] ");
-    if (tagEnd != std::string::npos) message = message.substr(tagEnd + 2);
-    throw InputError(source + ": malformed JSON: " + message);
-  }
+  json document = readJsonFile(file, "scene file");
   for (const std::string& assignment : overrides) applyOverride(document, assignment);
-  return parseScene(document, source);
+  return parseScene(document, file.string());
 }
 
 }  // namespace drape::scene

@@ -36,6 +36,10 @@ Scene parseScene(const nlohmann::json& document, const std::string& source);
 // object keys on the way are created; array indices must exist. Throws InputError.
 void applyOverride(nlohmann::json& document, std::string_view assignment);
 
+// The materials and thickness a cloth drawn into this scene gets: the first cloth's, or the
+// model's defaults when the scene has none.
+sim::ClothSettings drawnClothTemplate(const Scene& scene);
+
 // Finds a scene by path, or by name in the shipped scenes folder (`hang` -> assets/scenes/hang.json).
 std::filesystem::path resolveScenePath(const std::string& nameOrPath);
 std::filesystem::path sceneDirectory();
