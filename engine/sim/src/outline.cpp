@@ -11,9 +11,9 @@
 #include <queue>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -39,15 +39,18 @@ __extension__ typedef __int128 Wide;  // GCC and Clang; __extension__ keeps -Wpe
 constexpr Coord kUnitsPerSpacing = 4096;    // the lattice spacing in integer units
 constexpr Coord kMarginCells = 2;           // empty lattice cells around the stroke
 constexpr double kMaxSpanCells = 131072.0;  // 2^17: keeps coordinates below 2^30
-// Segment pairs the untangling may test before it calls the stroke a scribble (about half a second).
+// Segment pairs the untangling may test, and steps the fill may take beyond its linear work, before the outline is
+// called too intricate (each about half a second). Only strokes with far more detail than the spacing get there.
 constexpr std::uint64_t kMaxIntersectionTests = 50'000'000;
+constexpr std::uint64_t kMaxFillWork = 200'000'000;
+constexpr const char* kTooIntricate = "outline is too intricate to untangle (far more detail than the spacing)";
 
 // Collapse thresholds, in spacings: a node moves onto the loop when closer than kMoveDistance to a boundary
 // particle; boundary particles merge along the loop when closer than kMergeDistance.
 constexpr double kMoveDistance = 0.5;
 constexpr double kMergeDistance = 0.4;
-// A collapse may not leave a changed triangle with a quality (1 for equilateral, 0.87 for the lattice's half cell)
-// below this, unless the triangle was already worse.
+// Triangle quality (1 for equilateral, 0.87 for the lattice's half cell) that counts as good: a collapse may not
+// turn a good triangle poor, and poor ones are what edge flips work on.
 constexpr double kQualityFloor = 0.25;
 // How far along the loop (in spacings) a node landing on it may sweep up loop points that would flatten.
 constexpr double kSweepDistance = 0.75;
@@ -244,16 +247,23 @@ Point snapToLoopGrid(const Point& e, const Point& q, const Ratio& t) {
 }
 
 // Douglas-Peucker on an open polyline: keeps the ends and every point that is farther than `tolerance` from the
-// simplified line.
+// simplified line. Its worst case is quadratic (a comb whose every split peels off one tooth), so it scans at most
+// about 20 points per point; ranges still pending then keep all their points, which are already spacing/4 apart.
 std::vector<Point> simplify(const std::vector<Point>& points, double tolerance) {
   if (points.size() < 3) return points;
   std::vector<char> keep(points.size(), 0);
   keep.front() = keep.back() = 1;
   std::vector<std::pair<std::size_t, std::size_t>> stack{{0, points.size() - 1}};
+  std::size_t budget = 20 * points.size() + 1'000'000;
   while (!stack.empty()) {
     const auto [first, last] = stack.back();
     stack.pop_back();
     if (last <= first + 1) continue;
+    if (last - first > budget) {
+      std::fill(keep.begin() + static_cast<std::ptrdiff_t>(first), keep.begin() + static_cast<std::ptrdiff_t>(last), 1);
+      continue;
+    }
+    budget -= last - first;
     const glm::dvec2 a(static_cast<double>(points[first].x), static_cast<double>(points[first].z));
     const glm::dvec2 b(static_cast<double>(points[last].x), static_cast<double>(points[last].z));
     const glm::dvec2 ab = b - a;
@@ -324,8 +334,8 @@ struct Untangled {
 Untangled untangle(const std::vector<Point>& stroke, std::uint64_t& tests) {
   double totalLength = 0.0;
   for (std::size_t i = 0; i < stroke.size(); ++i) totalLength += length(stroke[i], stroke[(i + 1) % stroke.size()]);
-  const Coord cell = std::max<Coord>(kUnitsPerSpacing / 4,
-                                     static_cast<Coord>(totalLength / static_cast<double>(stroke.size())));
+  const Coord cell =
+      std::max<Coord>(kUnitsPerSpacing / 4, static_cast<Coord>(totalLength / static_cast<double>(stroke.size())));
   SegmentGrid grid(cell);
   Stamps stamps;
   std::vector<Point> path;                  // the simple path walked so far
@@ -381,7 +391,7 @@ Untangled untangle(const std::vector<Point>& stroke, std::uint64_t& tests) {
       std::size_t firstIndex = 0;
       stamps.next(segmentEnds.size());
       grid.forEachNear(e, q, isLive, [&](std::uint32_t id) {
-        if (++tests > kMaxIntersectionTests) fail("outline crosses itself too often to untangle");
+        if (++tests > kMaxIntersectionTests) fail(kTooIntricate);
         if (!stamps.firstTime(id)) return;
         const std::size_t k = segmentIndex[id];
         if (k + 2 == path.size()) return;  // the last segment, which ends at e
@@ -425,22 +435,24 @@ bool isSimple(const std::vector<Point>& loop, std::uint64_t& tests) {
     const Point& a = loop[i];
     const Point& b = loop[(i + 1) % n];
     stamps.next(n);
-    grid.forEachNear(a, b, [](std::uint32_t) { return true; }, [&](std::uint32_t j) {
-      if (++tests > kMaxIntersectionTests) fail("outline crosses itself too often to untangle");
-      if (!simple || j <= i || !stamps.firstTime(j)) return;
-      const Point& c = loop[j];
-      const Point& d = loop[(j + 1) % n];
-      const bool follows = j == i + 1, precedes = (j + 1) % n == i;
-      if (!follows && !precedes) {
-        if (firstContact(a, b, c, d)) simple = false;
-        return;
-      }
-      // Neighbours share one end; they must not fold back onto each other.
-      const Point& shared = follows ? b : a;
-      const Point& mine = follows ? a : b;
-      const Point& theirs = follows ? d : c;
-      if (orient(mine, shared, theirs) == 0 && dot(shared, mine, shared, theirs) > 0) simple = false;
-    });
+    grid.forEachNear(
+        a, b, [](std::uint32_t) { return true; },
+        [&](std::uint32_t j) {
+          if (++tests > kMaxIntersectionTests) fail(kTooIntricate);
+          if (!simple || j <= i || !stamps.firstTime(j)) return;
+          const Point& c = loop[j];
+          const Point& d = loop[(j + 1) % n];
+          const bool follows = j == i + 1, precedes = (j + 1) % n == i;
+          if (!follows && !precedes) {
+            if (firstContact(a, b, c, d)) simple = false;
+            return;
+          }
+          // Neighbours share one end; they must not fold back onto each other.
+          const Point& shared = follows ? b : a;
+          const Point& mine = follows ? a : b;
+          const Point& theirs = follows ? d : c;
+          if (orient(mine, shared, theirs) == 0 && dot(shared, mine, shared, theirs) > 0) simple = false;
+        });
   }
   return simple;
 }
@@ -480,7 +492,7 @@ std::vector<Point> removeShortEdges(const std::vector<Point>& loop, double minLe
       return alive[s] && alive[t] && next[s] == t;
     };
     grid.forEachNear(loop[a], loop[c], isLive, [&](std::uint32_t id) {
-      if (++tests > kMaxIntersectionTests) fail("outline crosses itself too often to untangle");
+      if (++tests > kMaxIntersectionTests) fail(kTooIntricate);
       if (!clear || !stamps.firstTime(id)) return;
       const std::size_t s = segmentStart[id], t = segmentEnd[id];
       if (s == a || t == c || t == a || s == c) return;  // the two segments being replaced and the neighbours
@@ -531,14 +543,18 @@ std::vector<Point> removeShortEdges(const std::vector<Point>& loop, double minLe
 // ----------------------------------------------------------------------------------------------------------------
 // The fill.
 
-enum EdgeType : int { kBottom = 0, kLeft = 1, kDiagonal = 2 };  // of a cell: (i,j)-(i+1,j), (i,j)-(i,j+1), (i+1,j)-(i,j+1)
+enum EdgeType : int {
+  kBottom = 0,
+  kLeft = 1,
+  kDiagonal = 2
+};  // of a cell: (i,j)-(i+1,j), (i,j)-(i,j+1), (i+1,j)-(i,j+1)
 
 struct Crossing {
-  std::int64_t edge = 0;       // lattice edge key
-  std::uint32_t segment = 0;   // loop segment loop[segment] - loop[segment + 1]
-  Ratio alongEdge;             // where, along the edge's own direction
-  Ratio alongSegment;          // where, along the segment
-  glm::dvec2 position{0.0};    // integer frame
+  std::int64_t edge = 0;      // lattice edge key
+  std::uint32_t segment = 0;  // loop segment loop[segment] - loop[segment + 1]
+  Ratio alongEdge;            // where, along the edge's own direction
+  Ratio alongSegment;         // where, along the segment
+  glm::dvec2 position{0.0};   // integer frame
 };
 
 struct Interval {  // inside nodes (begin..end-1, row) are vertices firstVertex...
@@ -604,6 +620,15 @@ class Filler {
   const std::vector<char>& triangleAlive() const { return triangleAlive_; }
 
  private:
+  // Counts work that is not linear in the size of the mesh (ear clipping, neighbourhoods), so that no outline can
+  // make the fill run away.
+  void spend(std::size_t steps) {
+    work_ += steps;
+    if (work_ > kMaxFillWork) {
+      fail("outline is too intricate to fill at spacing " + number(spacing_) + " m (far more detail than the spacing)");
+    }
+  }
+
   [[noreturn]] void internal(const char* what) const {
     fail("outline could not be meshed at spacing " + number(spacing_) + " m (internal check failed: " + what + ")");
   }
@@ -661,11 +686,10 @@ class Filler {
       if (a.segment == b.segment) return false;
       return less(a.alongEdge, b.alongEdge);
     });
-    crossings_.erase(std::unique(crossings_.begin(), crossings_.end(),
-                                 [](const Crossing& a, const Crossing& b) {
-                                   return a.edge == b.edge && a.segment == b.segment;
-                                 }),
-                     crossings_.end());
+    crossings_.erase(
+        std::unique(crossings_.begin(), crossings_.end(),
+                    [](const Crossing& a, const Crossing& b) { return a.edge == b.edge && a.segment == b.segment; }),
+        crossings_.end());
   }
 
   // Inside nodes, row by row, by the parity of loop crossings to their left (same perturbation as nodeSide).
@@ -677,8 +701,8 @@ class Filler {
       const Coord lo = std::min(p.z, q.z), hi = std::max(p.z, q.z);
       for (Coord j = floorDiv(lo, kUnitsPerSpacing) + 1; j <= floorDiv(hi, kUnitsPerSpacing); ++j) {
         // x of the crossing = numerator / denominator; the first column at or past it is ceil(x / spacing).
-        const Wide numerator = static_cast<Wide>(p.x) * (q.z - p.z) +
-                               static_cast<Wide>(j * kUnitsPerSpacing - p.z) * (q.x - p.x);
+        const Wide numerator =
+            static_cast<Wide>(p.x) * (q.z - p.z) + static_cast<Wide>(j * kUnitsPerSpacing - p.z) * (q.x - p.x);
         const Ratio x = makeRatio(numerator, q.z - p.z);
         rowCrossings.push_back({j, static_cast<Coord>(ceilDiv(x.numerator, x.denominator * kUnitsPerSpacing))});
       }
@@ -763,9 +787,18 @@ class Filler {
     for (const Crossing& c : crossings_) {
       const std::int64_t cell = c.edge / 3;
       switch (static_cast<EdgeType>(c.edge % 3)) {
-        case kBottom: clipped_.push_back(cell * 2); clipped_.push_back((cell - (columns_ + 1)) * 2 + 1); break;
-        case kLeft: clipped_.push_back(cell * 2); clipped_.push_back((cell - 1) * 2 + 1); break;
-        case kDiagonal: clipped_.push_back(cell * 2); clipped_.push_back(cell * 2 + 1); break;
+        case kBottom:
+          clipped_.push_back(cell * 2);
+          clipped_.push_back((cell - (columns_ + 1)) * 2 + 1);
+          break;
+        case kLeft:
+          clipped_.push_back(cell * 2);
+          clipped_.push_back((cell - 1) * 2 + 1);
+          break;
+        case kDiagonal:
+          clipped_.push_back(cell * 2);
+          clipped_.push_back(cell * 2 + 1);
+          break;
       }
     }
     std::sort(clipped_.begin(), clipped_.end());
@@ -823,8 +856,8 @@ class Filler {
         edges = {{{edgeKey(i, j, kLeft), true}, {edgeKey(i, j, kDiagonal), false}, {edgeKey(i, j, kBottom), false}}};
       } else {
         corners = {{{i + 1, j}, {i, j + 1}, {i + 1, j + 1}}};
-        edges = {{{edgeKey(i, j, kDiagonal), true}, {edgeKey(i, j + 1, kBottom), true},
-                  {edgeKey(i + 1, j, kLeft), false}}};
+        edges = {
+            {{edgeKey(i, j, kDiagonal), true}, {edgeKey(i, j + 1, kBottom), true}, {edgeKey(i + 1, j, kLeft), false}}};
       }
       events.clear();
       for (std::size_t e = 0; e < 3; ++e) {
@@ -835,8 +868,7 @@ class Filler {
         events.push_back(corner);
         const Point from = nodePoint(corners[e].first, corners[e].second);
         const Point to = nodePoint(corners[(e + 1) % 3].first, corners[(e + 1) % 3].second);
-        const auto range = std::equal_range(crossings_.begin(), crossings_.end(), edges[e].first,
-                                            CrossingEdgeOrder{});
+        const auto range = std::equal_range(crossings_.begin(), crossings_.end(), edges[e].first, CrossingEdgeOrder{});
         const auto first = static_cast<std::size_t>(range.first - crossings_.begin());
         const auto last = static_cast<std::size_t>(range.second - crossings_.begin());
         for (std::size_t n = 0; n < last - first; ++n) {
@@ -916,6 +948,7 @@ class Filler {
     std::vector<std::uint32_t> ring = polygon;
     while (ring.size() > 3) {
       const std::size_t n = ring.size();
+      spend(n * n);
       std::size_t best = n;
       double bestQuality = -std::numeric_limits<double>::infinity();
       for (std::size_t e = 0; e < n; ++e) {
@@ -961,7 +994,8 @@ class Filler {
 
   bool contains(const Triangle& t, std::uint32_t v) const { return t[0] == v || t[1] == v || t[2] == v; }
 
-  std::vector<std::uint32_t> neighbours(std::uint32_t v) const {
+  std::vector<std::uint32_t> neighbours(std::uint32_t v) {
+    spend(incident_[v].size());
     std::vector<std::uint32_t> result;
     for (const std::uint32_t t : incident_[v]) {
       if (!triangleAlive_[t]) continue;
@@ -976,7 +1010,7 @@ class Filler {
 
   // Link condition: the two ends of an edge may share no neighbour other than the third corners of the triangles on
   // the edge, or collapsing it would fold the mesh onto itself.
-  bool canJoin(std::uint32_t gone, std::uint32_t kept) const {
+  bool canJoin(std::uint32_t gone, std::uint32_t kept) {
     std::vector<std::uint32_t> opposite;
     for (const std::uint32_t t : incident_[gone]) {
       if (!triangleAlive_[t] || !contains(triangles_[t], kept)) continue;
@@ -1096,7 +1130,8 @@ class Filler {
     return worst;
   }
 
-  std::size_t trianglesOnEdge(std::uint32_t a, std::uint32_t b) const {
+  std::size_t trianglesOnEdge(std::uint32_t a, std::uint32_t b) {
+    spend(incident_[a].size());
     std::size_t count = 0;
     for (const std::uint32_t t : incident_[a]) {
       if (triangleAlive_[t] && contains(triangles_[t], b)) ++count;
@@ -1108,7 +1143,7 @@ class Filler {
     const Vertex& va = vertices_[a];
     const Vertex& vb = vertices_[b];
     if (!va.alive || !vb.alive) return false;
-    if (va.node != kNone && vb.node != kNone) return false;  // both stand for lattice nodes: keep both
+    if (va.node != kNone && vb.node != kNone) return false;            // both stand for lattice nodes: keep both
     std::array<std::pair<std::uint32_t, std::uint32_t>, 2> options{};  // (gone, kept)
     std::size_t count = 0;
     if (va.onLoop() && vb.onLoop()) {
@@ -1122,20 +1157,17 @@ class Filler {
       if (!vertices_[gone].movable) return false;
       options[count++] = {gone, gone == a ? b : a};
     }
-    // Try each way, keep the one leaving the best worst triangle (the first on a tie).
-    std::optional<double> bestQuality;
-    std::size_t best = 0;
+    // Try each way, keep the one leaving the best worst triangle (the first on a tie). A refused try undoes itself.
     Journal journal;
-    for (std::size_t o = 0; o < count; ++o) {
-      const std::optional<double> q = collapseAndSweep(options[o].first, options[o].second, journal);
-      if (q) undo(journal);
-      if (q && (!bestQuality || *q > *bestQuality + 1e-12)) {
-        bestQuality = q;
-        best = o;
-      }
-    }
-    if (!bestQuality) return false;
-    collapseAndSweep(options[best].first, options[best].second, journal);
+    if (count == 0) return false;
+    const std::optional<double> first = collapseAndSweep(options[0].first, options[0].second, journal);
+    if (count == 1) return first.has_value();
+    if (first) undo(journal);
+    const std::optional<double> second = collapseAndSweep(options[1].first, options[1].second, journal);
+    if (second && (!first || *second > *first + 1e-12)) return true;
+    if (second) undo(journal);
+    if (!first) return false;
+    collapseAndSweep(options[0].first, options[0].second, journal);
     return true;
   }
 
@@ -1176,6 +1208,7 @@ class Filler {
       const Vertex& vb = vertices_[b];
       double limit = 0.0;
       if (va.onLoop() && vb.onLoop()) {
+        if (va.corner != kNone && vb.corner != kNone) return;  // neither may go
         limit = kMergeDistance;
       } else if ((va.onLoop() && vb.movable) || (vb.onLoop() && va.movable)) {
         limit = kMoveDistance;
@@ -1183,7 +1216,9 @@ class Filler {
         return;
       }
       const double d = glm::length(vb.position - va.position);
-      if (d < limit * static_cast<double>(kUnitsPerSpacing)) queue.push({d, std::min(a, b), std::max(a, b)});
+      if (!(d < limit * static_cast<double>(kUnitsPerSpacing))) return;
+      if (va.onLoop() && vb.onLoop() && trianglesOnEdge(a, b) != 1) return;  // a chord: never merged
+      queue.push({d, std::min(a, b), std::max(a, b)});
     };
     const auto considerTriangle = [&](std::uint32_t t) {
       const Triangle& tri = triangles_[t];
@@ -1191,16 +1226,17 @@ class Filler {
       consider(tri[1], tri[2]);
       consider(tri[2], tri[0]);
     };
-    for (std::size_t t = firstPieceTriangle_; t < triangles_.size(); ++t) considerTriangle(static_cast<std::uint32_t>(t));
+    for (std::size_t t = firstPieceTriangle_; t < triangles_.size(); ++t)
+      considerTriangle(static_cast<std::uint32_t>(t));
     while (!queue.empty()) {
       const Candidate c = queue.top();
       queue.pop();
       if (!vertices_[c.a].alive || !vertices_[c.b].alive || trianglesOnEdge(c.a, c.b) == 0) continue;
       if (!tryCollapse(c.a, c.b)) continue;
+      // Edges around the kept vertex changed; edges refused before may now pass, so its triangles are looked at anew.
       const std::uint32_t kept = vertices_[c.a].alive ? c.a : c.b;
-      for (const std::uint32_t t : incident_[kept]) {
-        if (triangleAlive_[t]) considerTriangle(t);
-      }
+      std::erase_if(incident_[kept], [&](std::uint32_t t) { return !triangleAlive_[t]; });
+      for (const std::uint32_t t : incident_[kept]) considerTriangle(t);
     }
   }
 
@@ -1320,6 +1356,7 @@ class Filler {
   std::vector<char> triangleAlive_;
   std::size_t firstPieceTriangle_ = 0;
   std::vector<std::vector<std::uint32_t>> incident_;
+  std::uint64_t work_ = 0;
 };
 
 }  // namespace
@@ -1412,7 +1449,7 @@ Loop loopFromStroke(const OutlineSpec& spec, const Frame& frame) {
   for (int attempt = 0;; ++attempt) {
     loop.points = dropStraightPoints(loop.points);
     if (loop.points.size() < 3 || isSimple(loop.points, tests)) break;
-    if (attempt == 4) fail("outline crosses itself too often to untangle");
+    if (attempt == 4) fail(kTooIntricate);
     untangled = untangle(loop.points, tests);
     loop.tookLargest = loop.tookLargest || untangled.loopsWithArea > 1;
     loop.points = std::move(untangled.loop);
@@ -1553,7 +1590,9 @@ OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selec
   };
   const auto add = [&](ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
     const Real restLength = glm::length(rest.restPositions[b] - rest.restPositions[a]);
-    rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
+    // Coincident particles cannot survive the collapses; should they, a constraint without a direction is worse
+    // than none.
+    if (restLength > 0.0) rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
   };
   const auto columnRow = [&](ParticleIndex p) {
     return std::pair{nodeOfParticle[p] % stride, nodeOfParticle[p] / stride};
@@ -1565,7 +1604,8 @@ OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selec
       const auto [cb, rb] = columnRow(b);
       diagonal = std::abs(ca - cb) == 1 && std::abs(ra - rb) == 1;
     }
-    if (diagonal ? selection.shear : selection.stretch) add(diagonal ? ConstraintKind::shear : ConstraintKind::stretch, a, b);
+    if (diagonal ? selection.shear : selection.stretch)
+      add(diagonal ? ConstraintKind::shear : ConstraintKind::stretch, a, b);
   }
   for (const auto& [node, p00] : byNode) {
     const std::int64_t column = node % stride, row = node / stride;

@@ -20,12 +20,15 @@
 //  4. Fill. The lattice (spacing apart along x and z, with a node at the stroke's smallest x and z, and the
 //     lattice's own diagonal in each cell) is clipped exactly against the loop: triangles inside stay as they are,
 //     triangles the loop crosses become the part of them inside the loop, triangulated. So the mesh covers the loop
-//     exactly, with every corner of the loop a particle and every boundary edge on the loop. Slivers are then
-//     removed by collapsing short edges, each collapse checked to keep every triangle counter-clockwise and no worse
-//     than a quality floor: a lattice node closer than spacing/2 to the loop moves onto it, and boundary particles
-//     closer than 0.4 spacing along the loop merge (never removing a corner of the loop). A boundary particle then
-//     takes the lattice position (column, row) of the nearest unclaimed node outside the loop within spacing/2, so
-//     that the border joins in the lattice's constraints.
+//     exactly (total area = the loop's area), every corner of the loop is a particle and every boundary edge lies
+//     on the loop. The slivers clipping leaves are then removed by collapsing short edges, shortest first: a lattice
+//     node closer than spacing/2 to a boundary particle moves onto it (sweeping up loop points within 0.75 spacing
+//     that would otherwise flatten), and boundary particles closer than 0.4 spacing along the loop merge; a corner
+//     of the loop never goes. A collapse is undone unless every triangle it changed stays counter-clockwise and is
+//     either good (quality >= 0.25, 1 being equilateral and 0.87 the lattice's half cell) or at least half as good
+//     as before. Edges are flipped where that clearly improves a poor triangle (where the loop turns gently, three
+//     of its points can make one). A boundary particle then takes the lattice position (column, row) of the nearest
+//     unclaimed node outside the loop within spacing/2, so that the border joins in the lattice's constraints.
 //  5. Constrain, as the seed's lattice does, by lattice position: every triangle edge between diagonal neighbours is
 //     shear, the other diagonal of a whole cell (both of its triangles present) is shear too, every other triangle
 //     edge is stretch (on the border, edges between particles without a lattice position are stretch as well), and
@@ -51,16 +54,19 @@ struct OutlineSpec {
 };
 
 struct OutlineCloth {
-  ClothRest rest;                // columns = rows = 0 (not a lattice); triangles counter-clockwise seen from +y
-  std::vector<glm::dvec2> loop;  // the simple closed loop used, counter-clockwise seen from +y (first point not repeated)
+  ClothRest rest;  // columns = rows = 0 (not a lattice); triangles counter-clockwise seen from +y
+  // The simple closed loop the cloth fills, counter-clockwise seen from +y, first point not repeated. Its corners are
+  // particles and the cloth's boundary edges lie on it.
+  std::vector<glm::dvec2> loop;
   bool tookLargestLoop = false;  // true when the stroke crossed itself and the largest simple loop was kept
 };
 
 // Builds the rest mesh of a cloth cut to the outline. Throws std::invalid_argument with a one-line message when the
 // outline cannot make a cloth: spacing or height not finite (spacing not positive), a non-finite point, fewer than 3
 // distinct points, no enclosed area (collinear points), smaller than one cell (area under spacing^2), wider than
-// 2^17 spacings, so tangled that untangling would take too long, or more particles than kMaxParticles (estimated from
-// area and perimeter before anything is allocated; the message says how many).
+// 2^17 spacings, more particles than kMaxParticles (estimated from area and perimeter before anything is allocated;
+// the message says how many), or too intricate (so much detail finer than the spacing that untangling or filling it
+// would take more than about half a second). Deterministic: the same spec gives the same cloth.
 OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selection = {});
 
 }  // namespace drape::sim
