@@ -16,6 +16,7 @@ uniform bool strainMap;
 uniform bool twoSided;  // cloth: the back gets its own colour; colliders: one-sided solids
 uniform float strainScale;
 uniform sampler2DShadow shadowMap;
+uniform int shadowRadius;  // the kernel is (2 r + 1)^2 taps over the same width
 
 out vec4 fragmentColour;
 
@@ -25,9 +26,12 @@ float shadowFactor(vec3 normal) {
   float bias = 0.0015 + 0.003 * (1.0 - abs(dot(normal, lightDirection)));
   vec2 texel = 1.0 / vec2(textureSize(shadowMap, 0));
   float lit = 0.0;
-  for (int x = -2; x <= 2; ++x)
-    for (int y = -2; y <= 2; ++y) lit += texture(shadowMap, vec3(p.xy + vec2(x, y) * texel * 1.5, p.z - bias));
-  return lit / 25.0;
+  float step = 3.0 / float(max(shadowRadius, 1));
+  for (int x = -shadowRadius; x <= shadowRadius; ++x)
+    for (int y = -shadowRadius; y <= shadowRadius; ++y)
+      lit += texture(shadowMap, vec3(p.xy + vec2(x, y) * texel * step, p.z - bias));
+  float side = float(2 * shadowRadius + 1);
+  return lit / (side * side);
 }
 
 vec3 strainColour(float s) {

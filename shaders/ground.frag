@@ -10,6 +10,7 @@ uniform vec3 lightDirection;
 uniform vec3 eyePosition;
 uniform vec3 backgroundColour;
 uniform sampler2DShadow shadowMap;
+uniform int shadowRadius;  // the kernel is (2 r + 1)^2 taps over the same width: fewer are cheaper
 
 out vec4 fragmentColour;
 
@@ -18,9 +19,12 @@ float shadowFactor() {
   if (p.x < 0.0 || p.x > 1.0 || p.y < 0.0 || p.y > 1.0 || p.z > 1.0) return 1.0;
   vec2 texel = 1.0 / vec2(textureSize(shadowMap, 0));
   float lit = 0.0;
-  for (int x = -3; x <= 3; ++x)
-    for (int y = -3; y <= 3; ++y) lit += texture(shadowMap, vec3(p.xy + vec2(x, y) * texel * 2.0, p.z - 0.002));
-  return lit / 49.0;
+  float step = 6.0 / float(max(shadowRadius, 1));
+  for (int x = -shadowRadius; x <= shadowRadius; ++x)
+    for (int y = -shadowRadius; y <= shadowRadius; ++y)
+      lit += texture(shadowMap, vec3(p.xy + vec2(x, y) * texel * step, p.z - 0.002));
+  float side = float(2 * shadowRadius + 1);
+  return lit / (side * side);
 }
 
 void main() {

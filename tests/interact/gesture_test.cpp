@@ -308,6 +308,37 @@ TEST(Gesture, BadEventsAreReportedAndSkipped) {
   EXPECT_NE(world.finger(1), nullptr);  // the good event took
 }
 
+// What the app records is what the replay reads: every shipped script survives writing and reading.
+TEST(GestureFile, WritingAndReadingBackKeepsEveryEvent) {
+  for (const auto& entry : std::filesystem::directory_iterator(kAssets / "gestures")) {
+    SCOPED_TRACE(entry.path().string());
+    const interact::GestureScript script = scene::loadGesture(entry.path());
+    const interact::GestureScript back = scene::parseGesture(scene::gestureDocument(script), "back.json");
+    ASSERT_EQ(back.events.size(), script.events.size());
+    for (std::size_t i = 0; i < script.events.size(); ++i) {
+      const interact::GestureEvent& a = script.events[i];
+      const interact::GestureEvent& b = back.events[i];
+      EXPECT_EQ(a.time, b.time);
+      EXPECT_EQ(a.type, b.type);
+      EXPECT_EQ(a.finger, b.finger);
+      EXPECT_EQ(a.radius, b.radius);
+      EXPECT_EQ(a.pointer.has_value(), b.pointer.has_value());
+      if (a.pointer && b.pointer) {
+        EXPECT_EQ(a.pointer->kind, b.pointer->kind);
+        EXPECT_EQ(a.pointer->world, b.pointer->world);
+        EXPECT_EQ(a.pointer->screen, b.pointer->screen);
+      }
+    }
+    EXPECT_EQ(back.camera.has_value(), script.camera.has_value());
+    if (script.camera) {
+      EXPECT_NEAR(back.camera->pitch, script.camera->pitch, 1e-12);
+    }
+    EXPECT_EQ(back.settings.radius, script.settings.radius);
+    EXPECT_EQ(back.settings.pinchDistance, script.settings.pinchDistance);
+    EXPECT_EQ(back.length(), script.length());
+  }
+}
+
 // Issue 7's extreme case: a finger that jumps 100 m in one frame and back. The position model stays
 // finite and bounded by where the finger went; the force model may blow up, but then says so.
 TEST(ExtremeGesture, AFingerJumping100MetresInOneFrame) {

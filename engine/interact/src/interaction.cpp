@@ -61,6 +61,33 @@ void Interaction::setCamera(const render::Camera& camera, double aspect) {
   aspect_ = aspect > 0.0 && std::isfinite(aspect) ? aspect : 1.0;
 }
 
+void Interaction::setMode(Mode mode) {
+  mode_ = mode;
+  if (!record) return;
+  GestureEvent e;
+  e.type = GestureEvent::Type::mode;
+  e.mode = mode;
+  record(e);
+}
+
+void Interaction::setPlane(FingerPlane plane) {
+  settings_.plane = plane;
+  if (!record) return;
+  GestureEvent e;
+  e.type = GestureEvent::Type::plane;
+  e.plane = plane;
+  record(e);
+}
+
+void Interaction::note(GestureEvent::Type type, int id, std::optional<Vec3> at) {
+  if (!record) return;
+  GestureEvent e;
+  e.type = type;
+  e.finger = id;
+  if (at) e.pointer = Pointer::at(*at);
+  record(e);
+}
+
 bool Interaction::fail(std::string message) {
   lastError_ = std::move(message);
   return false;
@@ -129,6 +156,14 @@ bool Interaction::down(int id, const Pointer& pointer, std::optional<Real> radiu
     touch.stroke.push_back(*onTable);
     touch.depth = pointer.kind == Pointer::Kind::screen ? camera_.forward() : -kUp;
   }
+  if (record) {
+    GestureEvent e;
+    e.type = GestureEvent::Type::down;
+    e.finger = id;
+    e.pointer = Pointer::at(touch.onPlane);
+    if (radius) e.radius = r;
+    record(e);
+  }
   touches_.push_back(std::move(touch));
   return true;
 }
@@ -148,6 +183,8 @@ bool Interaction::move(int id, const Pointer& pointer) {
                                ? glm::normalize(camera_.ray(pointer.screen.x, pointer.screen.y, aspect_).direction +
                                                 touch->depth)
                                : touch->depth;
+        if (!touch->cutStarted && beforeCut) beforeCut();
+        touch->cutStarted = true;
         world_.cut(previous, *point, depth);
         touch->stroke.push_back(*point);
       }
@@ -157,6 +194,7 @@ bool Interaction::move(int id, const Pointer& pointer) {
       if (glm::length(*point - touch->stroke.back()) >= settings_.spacing * 0.1) touch->stroke.push_back(*point);
       break;
   }
+  note(GestureEvent::Type::move, id, *point);
   return true;
 }
 
@@ -165,6 +203,7 @@ bool Interaction::up(int id) {
   if (!touch) return fail("finger " + std::to_string(id) + " is not down");
   const Touch lifted = *touch;
   touches_.erase(touches_.begin() + (touch - touches_.data()));
+  note(GestureEvent::Type::up, id);
   if (lifted.mode == Mode::sticky && lifted.holds) world_.releaseFinger(id);
   if (lifted.mode == Mode::create) return spawn(lifted);
   return true;
@@ -178,6 +217,7 @@ bool Interaction::pin(int id) {
   }
   touches_.erase(touches_.begin() + (touch - touches_.data()));
   world_.pinFinger(id);
+  note(GestureEvent::Type::pin, id);
   return true;
 }
 
@@ -186,6 +226,13 @@ bool Interaction::lift(int id, Real height) {
   if (!touch) return fail("finger " + std::to_string(id) + " is not down");
   if (!std::isfinite(height)) return fail("finger " + std::to_string(id) + ": the height is not finite");
   touch->heightGoal = height;
+  if (record) {
+    GestureEvent e;
+    e.type = GestureEvent::Type::lift;
+    e.finger = id;
+    e.height = height;
+    record(e);
+  }
   return true;
 }
 
@@ -214,12 +261,20 @@ bool Interaction::unpin(const Pointer& pointer, Real radius) {
   }
   if (!point) return fail("the unpin point is not finite");
   if (world_.unpin(*point, radius) == 0) return fail("no pin within the radius");
+  if (record) {
+    GestureEvent e;
+    e.type = GestureEvent::Type::unpin;
+    e.pointer = Pointer::at(*point);
+    e.radius = radius;
+    record(e);
+  }
   return true;
 }
 
 void Interaction::cancelAll() {
   for (const Touch& touch : touches_) {
     if (touch.mode == Mode::sticky && touch.holds) world_.releaseFinger(touch.id);
+    note(GestureEvent::Type::up, touch.id);
   }
   touches_.clear();
 }

@@ -35,10 +35,7 @@ double GestureScript::length() const {
   return (events.empty() ? 0.0 : events.back().time) + 1.0;
 }
 
-Replay::Replay(sim::World& world, Interaction& interaction, const GestureScript& script)
-    : world_(world), interaction_(interaction), script_(script), following_(script.events.size(), kNone) {
-  interaction_.settings() = script.settings;
-  if (script.camera) interaction_.setCamera(*script.camera, script.aspect);
+ReplayClock::ReplayClock(const GestureScript& script) : script_(script), following_(script.events.size(), kNone) {
   for (std::size_t i = 0; i < script.events.size(); ++i) {
     if (!carriesFinger(script.events[i].type)) continue;
     for (std::size_t j = i + 1; j < script.events.size(); ++j) {
@@ -50,7 +47,7 @@ Replay::Replay(sim::World& world, Interaction& interaction, const GestureScript&
   }
 }
 
-std::optional<Pointer> Replay::between(std::size_t from, std::size_t to, double time) const {
+std::optional<Pointer> ReplayClock::between(std::size_t from, std::size_t to, double time) const {
   const GestureEvent& a = script_.events[from];
   const GestureEvent& b = script_.events[to];
   if (!a.pointer || !b.pointer || a.pointer->kind != b.pointer->kind) return std::nullopt;
@@ -62,24 +59,48 @@ std::optional<Pointer> Replay::between(std::size_t from, std::size_t to, double 
   return p;
 }
 
+std::vector<ReplayAction> ReplayClock::advance(double start, double dt) {
+  std::vector<ReplayAction> actions;
+  while (next_ < script_.events.size() && script_.events[next_].time <= start + 1e-9 * dt) {
+    const std::size_t index = next_++;
+    const GestureEvent& e = script_.events[index];
+    ReplayAction action;
+    action.index = index;
+    if (e.pointer) action.pointer = *e.pointer;
+    actions.push_back(action);
+    const auto keyframe =
+        std::find_if(keyframe_.begin(), keyframe_.end(), [&](const auto& k) { return k.first == e.finger; });
+    if (e.type == GestureEvent::Type::down) {
+      if (keyframe == keyframe_.end()) keyframe_.emplace_back(e.finger, index);
+    } else if (e.type == GestureEvent::Type::move) {
+      if (keyframe != keyframe_.end()) keyframe->second = index;
+    } else if (e.type == GestureEvent::Type::up || e.type == GestureEvent::Type::pin) {
+      if (keyframe != keyframe_.end()) keyframe_.erase(keyframe);
+    }
+  }
+  // Fingers on their way from one keyframe to the next.
+  for (const auto& [finger, from] : keyframe_) {
+    const std::size_t to = following_[from];
+    if (to == kNone || script_.events[to].type != GestureEvent::Type::move) continue;
+    if (const std::optional<Pointer> p = between(from, to, start + dt)) actions.push_back({from, true, *p});
+  }
+  return actions;
+}
+
+Replay::Replay(sim::World& world, Interaction& interaction, const GestureScript& script)
+    : world_(world), interaction_(interaction), script_(script), clock_(script) {
+  interaction_.settings() = script.settings;
+  if (script.camera) interaction_.setCamera(*script.camera, script.aspect);
+}
+
 void Replay::apply(std::size_t index) {
   const GestureEvent& e = script_.events[index];
-  const auto keyframe = std::find_if(keyframe_.begin(), keyframe_.end(), [&](const auto& k) { return k.first == e.finger; });
   bool ok = true;
   switch (e.type) {
-    case GestureEvent::Type::down:
-      ok = interaction_.down(e.finger, *e.pointer, e.radius);
-      if (ok) keyframe_.emplace_back(e.finger, index);
-      break;
-    case GestureEvent::Type::move:
-      ok = interaction_.move(e.finger, *e.pointer);
-      if (ok && keyframe != keyframe_.end()) keyframe->second = index;
-      break;
-    case GestureEvent::Type::up:
-    case GestureEvent::Type::pin:
-      ok = e.type == GestureEvent::Type::up ? interaction_.up(e.finger) : interaction_.pin(e.finger);
-      if (keyframe != keyframe_.end()) keyframe_.erase(keyframe);
-      break;
+    case GestureEvent::Type::down: ok = interaction_.down(e.finger, *e.pointer, e.radius); break;
+    case GestureEvent::Type::move: ok = interaction_.move(e.finger, *e.pointer); break;
+    case GestureEvent::Type::up: ok = interaction_.up(e.finger); break;
+    case GestureEvent::Type::pin: ok = interaction_.pin(e.finger); break;
     case GestureEvent::Type::unpin:
       ok = interaction_.unpin(*e.pointer, e.radius.value_or(interaction_.settings().radius));
       break;
@@ -97,13 +118,12 @@ void Replay::apply(std::size_t index) {
 
 sim::StepStatus Replay::step() {
   const double dt = world_.settings().solver.dt;
-  const double start = world_.time();
-  while (next_ < script_.events.size() && script_.events[next_].time <= start + 1e-9 * dt) apply(next_++);
-  // Fingers on their way from one keyframe to the next.
-  for (const auto& [finger, from] : keyframe_) {
-    const std::size_t to = following_[from];
-    if (to == kNone || script_.events[to].type != GestureEvent::Type::move) continue;
-    if (const std::optional<Pointer> p = between(from, to, start + dt)) interaction_.move(finger, *p);
+  for (const ReplayAction& action : clock_.advance(world_.time(), dt)) {
+    if (action.onTheWay) {
+      interaction_.move(script_.events[action.index].finger, action.pointer);
+    } else {
+      apply(action.index);
+    }
   }
   interaction_.update(dt);
   return world_.step();

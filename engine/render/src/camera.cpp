@@ -46,6 +46,20 @@ Ray Camera::ray(double x, double y, double aspect) const {
   return {eye(), glm::normalize(f + r * (ndcX * halfHeight * aspect) + u * (ndcY * halfHeight))};
 }
 
+std::optional<glm::dvec2> Camera::project(glm::dvec3 point, double aspect) const {
+  const glm::dvec3 f = forward();
+  const glm::dvec3 r = glm::normalize(glm::cross(f, glm::dvec3{0.0, 1.0, 0.0}));
+  const glm::dvec3 u = glm::cross(r, f);
+  const glm::dvec3 d = point - eye();
+  const double depth = glm::dot(d, f);
+  if (!(depth > 1e-9)) return std::nullopt;
+  const double halfHeight = std::tan(fieldOfView / 2.0);
+  // The inverse of ray(): ndc = (d . r, d . u) / (depth * halfHeight * (aspect, 1)).
+  const double ndcX = glm::dot(d, r) / (depth * halfHeight * aspect);
+  const double ndcY = glm::dot(d, u) / (depth * halfHeight);
+  return glm::dvec2{(ndcX + 1.0) / 2.0, (1.0 - ndcY) / 2.0};
+}
+
 Camera Camera::framing(glm::dvec3 lower, glm::dvec3 upper, double yaw, double pitch, double aspect) {
   Camera camera;
   camera.yaw = yaw;

@@ -24,7 +24,6 @@ extern const std::string_view cloth_vert, cloth_frag, ground_frag, shadow_vert, 
 
 namespace {
 
-constexpr int kShadowMapSize = 2048;
 const glm::dvec3 kTowardsLight = glm::normalize(glm::dvec3{0.35, 1.0, 0.25});
 
 // A GL info log as the one-line message of a RenderError.
@@ -151,6 +150,7 @@ struct Renderer::Impl {
   GLuint shadowFramebuffer = 0, shadowTexture = 0;
   GLuint sampleFramebuffer = 0, sampleColour = 0, sampleDepth = 0;
   int sampleWidth = 0, sampleHeight = 0, samples = 0;
+  int shadowMapSize = 0;
   GLuint groundVao = 0, groundBuffer = 0;
   GLuint overlayVao = 0, overlayBuffer = 0;
   GLuint colliderVao = 0, colliderPositions = 0, colliderNormals = 0, colliderIndices = 0;
@@ -250,6 +250,14 @@ struct Renderer::Impl {
     glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(n * sizeof(float)), strains.data());
   }
 
+  void resizeShadowMap(int size) {
+    size = std::clamp(size, 256, 4096);
+    if (size == shadowMapSize) return;
+    shadowMapSize = size;
+    glBindTexture(GL_TEXTURE_2D, shadowTexture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, nullptr);
+  }
+
   void ensureSampleTarget(int width, int height) {
     if (samples == 0 || (width == sampleWidth && height == sampleHeight)) return;
     if (!sampleFramebuffer) {
@@ -300,8 +308,7 @@ Renderer::Renderer(GetProcAddress getProcAddress) : impl_(std::make_unique<Impl>
   // Shadow map: a depth texture compared in hardware, filtered linearly (then PCF in the shader).
   glGenTextures(1, &r.shadowTexture);
   glBindTexture(GL_TEXTURE_2D, r.shadowTexture);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, kShadowMapSize, kShadowMapSize, 0, GL_DEPTH_COMPONENT,
-               GL_UNSIGNED_INT, nullptr);
+  r.resizeShadowMap(FrameOptions{}.shadowMapSize);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -425,7 +432,8 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
 
   // Shadow pass.
   glBindFramebuffer(GL_FRAMEBUFFER, r.shadowFramebuffer);
-  glViewport(0, 0, kShadowMapSize, kShadowMapSize);
+  r.resizeShadowMap(options.shadowMapSize);
+  glViewport(0, 0, r.shadowMapSize, r.shadowMapSize);
   glClear(GL_DEPTH_BUFFER_BIT);
   glUseProgram(r.shadowProgram);
   setMatrix(r.shadowProgram, "lightViewProjection", lightViewProjection);
@@ -442,8 +450,9 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   // Main pass, multisampled when the context can.
   const double aspect = static_cast<double>(width) / height;
   const glm::mat4 viewProjection = camera.projection(aspect) * camera.view();
-  r.ensureSampleTarget(width, height);
-  glBindFramebuffer(GL_FRAMEBUFFER, r.samples > 0 ? r.sampleFramebuffer : static_cast<GLuint>(target));
+  const bool multisample = options.multisample && r.samples > 0;
+  if (multisample) r.ensureSampleTarget(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, multisample && r.samples > 0 ? r.sampleFramebuffer : static_cast<GLuint>(target));
   glViewport(0, 0, width, height);
   glClearColor(options.backgroundColour.r, options.backgroundColour.g, options.backgroundColour.b, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -463,6 +472,7 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   setVec3(r.groundProgram, "eyePosition", eye);
   setVec3(r.groundProgram, "backgroundColour", options.backgroundColour);
   glUniform1i(uniform(r.groundProgram, "shadowMap"), 0);
+  glUniform1i(uniform(r.groundProgram, "shadowRadius"), std::clamp(options.shadowSoftness, 0, 3));
   glBindVertexArray(r.groundVao);
   glBindBuffer(GL_ARRAY_BUFFER, r.groundBuffer);
   glBufferSubData(GL_ARRAY_BUFFER, 0, sizeof quad, quad);
@@ -482,6 +492,7 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glUniform1i(uniform(r.clothProgram, "strainMap"), options.strainMap ? 1 : 0);
   glUniform1f(uniform(r.clothProgram, "strainScale"), std::max(1e-6f, options.strainScale));
   glUniform1i(uniform(r.clothProgram, "shadowMap"), 0);
+  glUniform1i(uniform(r.clothProgram, "shadowRadius"), std::clamp(options.shadowSoftness - 1, 0, 2));
   if (colliderIndexCount > 0) {
     glUniform1i(uniform(r.clothProgram, "twoSided"), 0);
     glUniform1i(uniform(r.clothProgram, "strainMap"), 0);
@@ -539,7 +550,7 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   r.drawOverlay(r.overlayScratch, GL_POINTS);
   glEnable(GL_DEPTH_TEST);
 
-  if (r.samples > 0) {  // resolve into the caller's framebuffer
+  if (multisample && r.samples > 0) {  // resolve into the caller's framebuffer
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r.sampleFramebuffer);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
@@ -547,6 +558,8 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target));
   glBindVertexArray(0);
 }
+
+void Renderer::finish() const { glFinish(); }
 
 std::vector<std::uint8_t> Renderer::readPixels(int width, int height) const {
   std::vector<std::uint8_t> pixels(static_cast<std::size_t>(width) * height * 4);

@@ -179,6 +179,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
 Scene parseScene(const json& document, const std::string& source) {
   Scene scene;
   scene.source = source;
+  scene.document = document.dump(-1, ' ', false, json::error_handler_t::replace);
   ObjectReader root(document, "", source);
   scene.name = root.text("name", std::filesystem::path(source).stem().string());
   scene.description = root.text("description", "");

@@ -166,6 +166,7 @@ void sever(Topology& topology, std::uint32_t t, int edge) {
   const std::int32_t other = topology.neighbour[t][static_cast<std::size_t>(edge)];
   if (other < 0) return;
   topology.neighbour[t][static_cast<std::size_t>(edge)] = -1;
+  ++topology.torn;
   for (std::int32_t& back : topology.neighbour[static_cast<std::size_t>(other)]) {
     if (back == static_cast<std::int32_t>(t)) back = -1;
   }
@@ -337,6 +338,7 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     ConstraintTemplate& x = topology.templates[topology.source[static_cast<std::size_t>(ConstraintKind::stretch)][j]];
     if (x.link == ConstraintTemplate::Link::free) {
       x.broken = true;
+      ++topology.torn;
       changed = true;
       continue;
     }
@@ -404,6 +406,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
     if ((da >= 0.0) == (db >= 0.0)) continue;
     if (!within(xa + (xb - xa) * (da / (da - db)))) continue;
     x.broken = true;
+    ++topology.torn;
     changed = true;
   }
   if (!changed) return false;

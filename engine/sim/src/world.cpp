@@ -202,7 +202,7 @@ void World::buildTethers(std::size_t c) {
   for (std::size_t p = 0; p < cloth.state.position.size(); ++p) {
     if (!cloth.state.pinned[p]) continue;
     for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-      if (cloth.state.inverseMass[i] == 0.0) continue;
+      if (cloth.state.inverseMass[i] == 0.0 || cloth.piece[i] != cloth.piece[p]) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
       const Real length = glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]);
       scratch_[c].tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
@@ -626,6 +626,47 @@ void World::setTearing(const TearSettings& tearing) {
   buildPipeline();
 }
 
+// ---- tuning while running ---------------------------------------------------------------------
+
+void World::tune(const WorldSettings& next) {
+  WorldSettings candidate = next;
+  candidate.cloths = settings_.cloths;
+  require(candidate.solver.model == settings_.solver.model && candidate.solver.integrator == settings_.solver.integrator,
+          "the model and the integrator cannot change while the world runs");
+  require(candidate.colliders.size() == settings_.colliders.size(), "colliders cannot be added or removed while the world runs");
+  for (std::size_t i = 0; i < candidate.colliders.size(); ++i) {
+    // Only the friction of a collider is tunable: everything else stays as it is.
+    const Friction friction = candidate.colliders[i].friction;
+    candidate.colliders[i] = settings_.colliders[i];
+    candidate.colliders[i].friction = friction;
+  }
+  validate(candidate);
+  const Real hBefore = static_cast<Real>(substepDt());
+  const bool tethersChanged = candidate.solver.tethers != settings_.solver.tethers;
+  settings_ = std::move(candidate);
+  const Real hAfter = static_cast<Real>(substepDt());
+  if (historyStarted_ && hAfter != hBefore) {
+    // Verlet keeps velocity as x - x_prev over one substep: rescale it to the new substep.
+    for (Cloth& cloth : cloths_) {
+      ParticleState& s = cloth.state;
+      for (std::size_t i = 0; i < s.position.size(); ++i) {
+        s.previousPosition[i] = s.position[i] - (s.position[i] - s.previousPosition[i]) * (hAfter / hBefore);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < colliders_.size(); ++i) {
+    colliders_[i] = Collider(settings_.colliders[i]);
+    colliders_[i].setTime(time());
+  }
+  if (tethersChanged) {
+    for (std::size_t c = 0; c < cloths_.size(); ++c) {
+      scratch_[c].tethers.clear();
+      buildTethers(c);
+    }
+  }
+  buildPipeline();
+}
+
 // ---- cloths while running ----------------------------------------------------------------------
 
 int World::addCloth(const ClothSettings& settings) {
@@ -646,6 +687,56 @@ int World::addCloth(const ClothSettings& settings) {
   }
   topologyVersion_ = nextTopologyVersion();
   return static_cast<int>(c);
+}
+
+void World::restoreCloths(std::vector<Cloth> cloths) {
+  std::size_t particles = 0;
+  for (const Cloth& cloth : cloths) {
+    const ParticleState& s = cloth.state;
+    const std::size_t n = cloth.rest.restPositions.size();
+    particles += n;
+    validateCloth(cloth.settings, settings_.solver.model);
+    require(s.position.size() == n && s.previousPosition.size() == n && s.mass.size() == n &&
+                s.inverseMass.size() == n && s.pinned.size() == n &&
+                (settings_.solver.model == Model::force ? s.velocity.size() == n : s.velocity.empty()),
+            "a cloth's arrays do not all have one entry per particle");
+    for (std::size_t i = 0; i < n; ++i) {
+      require(finite(cloth.rest.restPositions[i]) && finite(s.position[i]) && finite(s.previousPosition[i]) &&
+                  (s.velocity.empty() || finite(s.velocity[i])),
+              "a cloth has a position that is not finite");
+      require(finite(s.mass[i]) && s.mass[i] > 0.0 && std::isfinite(1.0 / s.mass[i]), "a particle's mass must be positive");
+    }
+    for (const glm::uvec3& t : cloth.rest.triangles) {
+      require(t.x < n && t.y < n && t.z < n, "a triangle names a particle the cloth does not have");
+    }
+    for (const auto& list : cloth.rest.constraints) {
+      for (const DistanceConstraint& c : list) {
+        require(c.a < n && c.b < n && c.a != c.b, "a constraint names a particle the cloth does not have");
+        require(finite(c.restLength) && c.restLength >= 0.0, "a constraint's rest length must be finite");
+      }
+    }
+  }
+  require(particles <= static_cast<std::size_t>(kMaxParticles), "too many particles");
+  while (!fingers_.empty()) releaseFinger(fingers_.front().id);
+  cloths_ = std::move(cloths);
+  settings_.cloths.clear();
+  scratch_.assign(cloths_.size(), SolverScratch{});
+  held_.clear();
+  lastGood_.clear();
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    Cloth& cloth = cloths_[c];
+    settings_.cloths.push_back(cloth.settings);
+    ParticleState& s = cloth.state;
+    // Inverse masses follow from masses and pins (no finger holds anything now).
+    for (std::size_t i = 0; i < s.mass.size(); ++i) s.inverseMass[i] = s.pinned[i] ? 0.0 : 1.0 / s.mass[i];
+    cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
+    held_.emplace_back(s.position.size(), 0);
+    buildTethers(c);
+    if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(s.position.size(), Vec3{0.0});
+    if (settings_.solver.model == Model::force) force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), scratch_[c]);
+  }
+  buildPipeline();
+  topologyVersion_ = nextTopologyVersion();
 }
 
 void World::removeCloth(int index) {

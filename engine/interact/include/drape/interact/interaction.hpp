@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -62,6 +63,21 @@ struct InteractionSettings {
   sim::ClothSettings material;    // materials and thickness of drawn cloths
 };
 
+// One event of a finger's life, as gesture scripts hold them and the app records them.
+struct GestureEvent {
+  enum class Type : std::uint8_t { down, move, up, pin, unpin, lift, mode, plane };
+  double time = 0.0;  // s
+  Type type = Type::move;
+  int finger = 0;
+  std::optional<Pointer> pointer;  // down, move, unpin
+  std::optional<Real> radius;      // down (m), unpin (m)
+  Real height = 0.0;               // lift (m)
+  Mode mode = Mode::sticky;        // mode
+  FingerPlane plane = FingerPlane::table;  // plane
+};
+
+std::string_view name(GestureEvent::Type type);
+
 // What the overlay shows of a finger.
 struct TouchView {
   int id;
@@ -78,9 +94,9 @@ class Interaction {
 
   void setCamera(const render::Camera& camera, double aspect);
   const render::Camera& camera() const { return camera_; }
-  void setMode(Mode mode) { mode_ = mode; }
+  void setMode(Mode mode);
   Mode mode() const { return mode_; }
-  void setPlane(FingerPlane plane) { settings_.plane = plane; }
+  void setPlane(FingerPlane plane);
   InteractionSettings& settings() { return settings_; }
   const InteractionSettings& settings() const { return settings_; }
 
@@ -97,6 +113,12 @@ class Interaction {
   void update(Real dt);
   // Removes the most recently drawn cloth still in the world. False if there is none.
   bool undoSpawn();
+
+  // Called once per cut stroke, before it first cuts, so the app can take a snapshot to undo it.
+  std::function<void()> beforeCut;
+  // Called after every event that took, with world pointers (where the finger went down, moved,
+  // drew or cut), so a session can be recorded as a gesture script; the time is the caller's.
+  std::function<void(const GestureEvent&)> record;
 
   const std::string& lastError() const { return lastError_; }
   std::vector<TouchView> touches() const;
@@ -115,9 +137,11 @@ class Interaction {
     bool holds = false;
     std::vector<Vec3> stroke;
     Vec3 depth{0.0, -1.0, 0.0};   // cut: the direction the cut surface extends along
+    bool cutStarted = false;  // beforeCut was called for this stroke
   };
 
   bool fail(std::string message);
+  void note(GestureEvent::Type type, int id, std::optional<Vec3> at = std::nullopt);
   Touch* find(int id);
   std::optional<Vec3> pointOnPlane(const Pointer& pointer, Vec3 anchor, Vec3 normal) const;
   bool spawn(const Touch& touch);

@@ -15,20 +15,6 @@
 
 namespace drape::interact {
 
-struct GestureEvent {
-  enum class Type : std::uint8_t { down, move, up, pin, unpin, lift, mode, plane };
-  double time = 0.0;  // s
-  Type type = Type::move;
-  int finger = 0;
-  std::optional<Pointer> pointer;  // down, move, unpin
-  std::optional<Real> radius;      // down (m), unpin (m)
-  Real height = 0.0;               // lift (m)
-  Mode mode = Mode::sticky;        // mode
-  FingerPlane plane = FingerPlane::table;  // plane
-};
-
-std::string_view name(GestureEvent::Type type);
-
 struct GestureScript {
   std::string source;  // where it came from, for messages
   std::optional<render::Camera> camera;
@@ -40,6 +26,33 @@ struct GestureScript {
   double length() const;
 };
 
+// One thing due before a step: an event of the script, or a finger's move on its way from one
+// keyframe to the next.
+struct ReplayAction {
+  std::size_t index = 0;  // the script's event (for a move on the way: the finger's last keyframe)
+  bool onTheWay = false;
+  Pointer pointer;        // on the way: where the finger is at the end of the step
+};
+
+// The timeline of a script without its effects: what is due when. The replay below applies the
+// actions to an Interaction; the app turns them into touch events pushed through SDL.
+class ReplayClock {
+ public:
+  explicit ReplayClock(const GestureScript& script);
+  std::vector<ReplayAction> advance(double start, double dt);
+  bool finished() const { return next_ >= script_.events.size(); }
+
+ private:
+  std::optional<Pointer> between(std::size_t from, std::size_t to, double time) const;
+
+  const GestureScript& script_;
+  std::size_t next_ = 0;
+  // Per event: the index of the same finger's next down/move/up/pin event, or npos.
+  std::vector<std::size_t> following_;
+  // Per finger down: its last keyframe.
+  std::vector<std::pair<int, std::size_t>> keyframe_;
+};
+
 class Replay {
  public:
   // The interaction's camera and settings are set from the script.
@@ -47,22 +60,17 @@ class Replay {
 
   // Applies what is due, then steps the world once.
   sim::StepStatus step();
-  bool finished() const { return next_ >= script_.events.size(); }
+  bool finished() const { return clock_.finished(); }
   // Events that could not be honoured: "gesture.json: event 4 (up at 1.20 s): finger 2 is not down; skipped".
   const std::vector<std::string>& reports() const { return reports_; }
 
  private:
   void apply(std::size_t index);
-  std::optional<Pointer> between(std::size_t from, std::size_t to, double time) const;
 
   sim::World& world_;
   Interaction& interaction_;
   const GestureScript& script_;
-  std::size_t next_ = 0;
-  // Per event: the index of the same finger's next down/move/up/pin event, or npos.
-  std::vector<std::size_t> following_;
-  // Per finger down: the last keyframe applied.
-  std::vector<std::pair<int, std::size_t>> keyframe_;
+  ReplayClock clock_;
   std::vector<std::string> reports_;
 };
 

@@ -3,7 +3,10 @@
 // screen points into rays, the renderer to build its matrices.
 #pragma once
 
+#include <optional>
+
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace drape::render {
@@ -33,6 +36,10 @@ struct Camera {
 
   // The ray through a point of the image, in normalised coordinates x, y in [0, 1] from the top left.
   Ray ray(double x, double y, double aspect) const;
+
+  // Where `point` appears in the image, in the normalised coordinates ray() takes; nothing if it
+  // is behind the eye.
+  std::optional<glm::dvec2> project(glm::dvec3 point, double aspect) const;
 
   // Looks at the box [lower, upper] from (yaw, pitch), far enough that all of it is in view.
   static Camera framing(glm::dvec3 lower, glm::dvec3 upper, double yaw, double pitch, double aspect);

@@ -51,6 +51,7 @@ struct Topology {
   std::vector<std::array<std::int32_t, 3>> neighbour;
   std::vector<Real> triangleArea;  // m^2, at rest
   std::vector<ConstraintTemplate> templates;
+  std::size_t torn = 0;  // edges severed and links broken so far (tearing and cutting)
   // Per current constraint, by kind: the template it came from.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> source;
 };

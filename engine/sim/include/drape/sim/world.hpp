@@ -105,10 +105,25 @@ class World {
   // threshold that is not a finite number above 1.
   void setTearing(const TearSettings& tearing);
 
+  // Changes, while the world runs, what can change without rebuilding it: the solver's step,
+  // substeps, iterations, damping, XPBD and tethers; gravity; the air; self-collision; tearing;
+  // the colliders' friction. The model, the integrator, the colliders' shapes and the cloths stay
+  // (`next.cloths` is ignored). Velocities are kept across a change of step. Throws
+  // std::invalid_argument, changing nothing, when `next` is not valid or changes what cannot.
+  void tune(const WorldSettings& next);
+  // After a divergence the world holds its last good state and refuses to step; this lets it go on
+  // from there (after tuning it, say).
+  void clearDivergence() { divergence_.reset(); }
+
   // Adds a cloth while the world runs (it starts at rest) and returns its index; throws
   // std::invalid_argument like the constructor. Removing a cloth drops what fingers held of it.
   int addCloth(const ClothSettings& cloth);
   void removeCloth(int index);
+  // Puts back cloths as they were (from cloths(), before a cut, say, or read from a file): every
+  // finger lets go first. Throws std::invalid_argument, changing nothing, if a cloth is not
+  // consistent (array sizes, indices out of range, a non-finite or non-positive number) or the
+  // particles pass the limit.
+  void restoreCloths(std::vector<Cloth> cloths);
 
  private:
   void buildPipeline();

@@ -1,0 +1,29 @@
+// Snapshots: a session saved to a file and loaded back. The scene (its JSON document) and every
+// cloth as it is now, torn mesh and all: rest positions, triangles, constraints, positions, previous
+// positions, velocities (force model), masses and pins. Loading one is as strict as loading a
+// scene: anything malformed is an InputError naming the file and the key.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "drape/scene/scene.hpp"
+#include "drape/sim/world.hpp"
+
+namespace drape::scene {
+
+struct Snapshot {
+  Scene scene;
+  double time = 0.0;  // s, when it was taken (shown, not simulated from)
+  std::vector<sim::Cloth> cloths;
+};
+
+nlohmann::json snapshotDocument(const Scene& scene, const sim::World& world);
+Snapshot loadSnapshot(const std::filesystem::path& file);
+
+// A world made from the snapshot: the scene's world with its cloths put back. Throws InputError.
+sim::World makeWorld(const Snapshot& snapshot);
+
+}  // namespace drape::scene
