@@ -1,0 +1,461 @@
+#include "app.hpp"
+
+#include <SDL.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include <imgui.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <backends/imgui_impl_sdl.h>
+#include <nlohmann/json.hpp>
+
+#include "drape/interact/replay.hpp"
+#include "drape/render/renderer.hpp"
+#include "drape/scene/error.hpp"
+#include "drape/scene/gesture.hpp"
+#include "drape/scene/output.hpp"
+#include "input.hpp"
+#include "panels.hpp"
+#include "png.hpp"
+#include "session.hpp"
+
+namespace drape::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The touch device replayed scripts speak through.
+constexpr SDL_TouchID kReplayTouch = 4242;
+
+// The window's size in points, its drawable size in pixels (different on high-DPI screens).
+struct WindowSize {
+  int width = 0, height = 0;
+  int pixelsWide = 0, pixelsHigh = 0;
+  bool minimised = false;
+  double aspect() const { return height > 0 ? static_cast<double>(width) / height : 1.0; }
+  bool drawable() const { return !minimised && pixelsWide > 0 && pixelsHigh > 0; }
+};
+
+WindowSize sizeOf(SDL_Window* window) {
+  WindowSize size;
+  SDL_GetWindowSize(window, &size.width, &size.height);
+  SDL_GL_GetDrawableSize(window, &size.pixelsWide, &size.pixelsHigh);
+  size.minimised = (SDL_GetWindowFlags(window) & SDL_WINDOW_MINIMIZED) != 0;
+  return size;
+}
+
+// Dear ImGui's frame without its SDL backend's ImGui_ImplSDL2_NewFrame: that one calls
+// SDL_CaptureMouse every frame, which on X11 swallows touch events (SDL #11469, imgui #8150). The
+// backend still handles keys, text and the wheel (ImGui_ImplSDL2_ProcessEvent); position and
+// buttons come from here.
+struct ImGuiMouse {
+  bool pressed[3] = {false, false, false};  // a press this frame, so a click shorter than a frame counts
+
+  void newFrame(SDL_Window* window, const WindowSize& size, double seconds) {
+    ImGuiIO& io = ImGui::GetIO();
+    io.DisplaySize = ImVec2(static_cast<float>(size.width), static_cast<float>(size.height));
+    if (size.width > 0 && size.height > 0) {
+      io.DisplayFramebufferScale = ImVec2(static_cast<float>(size.pixelsWide) / static_cast<float>(size.width),
+                                          static_cast<float>(size.pixelsHigh) / static_cast<float>(size.height));
+    }
+    io.DeltaTime = static_cast<float>(std::max(seconds, 1e-4));
+    int x = 0, y = 0;
+    const Uint32 buttons = SDL_GetMouseState(&x, &y);
+    io.MousePos = SDL_GetMouseFocus() == window ? ImVec2(static_cast<float>(x), static_cast<float>(y))
+                                                : ImVec2(-FLT_MAX, -FLT_MAX);
+    const Uint32 masks[3] = {SDL_BUTTON(SDL_BUTTON_LEFT), SDL_BUTTON(SDL_BUTTON_RIGHT), SDL_BUTTON(SDL_BUTTON_MIDDLE)};
+    for (int i = 0; i < 3; ++i) {
+      io.MouseDown[i] = pressed[i] || (buttons & masks[i]) != 0;
+      pressed[i] = false;
+    }
+  }
+  void press(int sdlButton) {
+    if (sdlButton == SDL_BUTTON_LEFT) pressed[0] = true;
+    if (sdlButton == SDL_BUTTON_RIGHT) pressed[1] = true;
+    if (sdlButton == SDL_BUTTON_MIDDLE) pressed[2] = true;
+  }
+};
+
+void pushTouch(SDL_Window* window, Uint32 type, int finger, glm::dvec2 at) {
+  SDL_Event event{};
+  event.type = type;
+  event.tfinger.timestamp = SDL_GetTicks();
+  event.tfinger.touchId = kReplayTouch;
+  event.tfinger.fingerId = finger;
+  event.tfinger.x = static_cast<float>(at.x);
+  event.tfinger.y = static_cast<float>(at.y);
+  event.tfinger.pressure = 1.0f;
+  event.tfinger.windowID = SDL_GetWindowID(window);
+  SDL_PushEvent(&event);
+}
+
+// Replays a gesture script through SDL: downs, moves and ups become touch events pushed onto SDL's
+// queue, so they travel the same path as a real touch screen's; the rest (pin, lift, unpin, mode,
+// plane) have no touch event and are applied to the interaction directly.
+class TouchReplay {
+ public:
+  TouchReplay(interact::GestureScript script) : script_(std::move(script)), clock_(script_) {}
+
+  const interact::GestureScript& script() const { return script_; }
+
+  void beforeStep(SDL_Window* window, Session& session, const InputMapper& input, double aspect) {
+    const double dt = session.world().settings().solver.dt;
+    for (const interact::ReplayAction& action : clock_.advance(session.world().time(), dt)) {
+      const interact::GestureEvent& e = script_.events[action.index];
+      const std::optional<glm::dvec2> at = action.pointer.kind == interact::Pointer::Kind::screen
+                                               ? std::optional<glm::dvec2>(action.pointer.screen)
+                                               : session.camera().project(action.pointer.world, aspect);
+      using T = interact::GestureEvent::Type;
+      const T type = action.onTheWay ? T::move : e.type;
+      const std::optional<int> id = input.touchFinger(kReplayTouch, e.finger);
+      switch (type) {
+        case T::down:
+        case T::move:
+          if (at) pushTouch(window, type == T::down ? SDL_FINGERDOWN : SDL_FINGERMOTION, e.finger, *at);
+          break;
+        case T::up: pushTouch(window, SDL_FINGERUP, e.finger, at.value_or(glm::dvec2{0.5})); break;
+        case T::pin:
+          if (id) session.interaction().pin(*id);
+          break;
+        case T::lift:
+          if (id) session.interaction().lift(*id, e.height);
+          break;
+        case T::unpin:
+          session.interaction().unpin(action.pointer, e.radius.value_or(session.interaction().settings().radius));
+          break;
+        case T::mode: session.interaction().setMode(e.mode); break;
+        case T::plane: session.interaction().setPlane(e.plane); break;
+      }
+    }
+  }
+
+ private:
+  interact::GestureScript script_;
+  interact::ReplayClock clock_;
+};
+
+InputEvent mouseEvent(InputEvent::Kind kind, int x, int y, const WindowSize& size) {
+  InputEvent event;
+  event.kind = kind;
+  event.x = size.width > 0 ? static_cast<double>(x) / size.width : 0.0;
+  event.y = size.height > 0 ? static_cast<double>(y) / size.height : 0.0;
+  const SDL_Keymod mods = SDL_GetModState();
+  event.shift = (mods & KMOD_SHIFT) != 0;
+  event.ctrl = (mods & KMOD_CTRL) != 0;
+  return event;
+}
+
+std::optional<InputEvent> translate(const SDL_Event& e, const WindowSize& size) {
+  InputEvent event;
+  switch (e.type) {
+    case SDL_FINGERDOWN:
+    case SDL_FINGERMOTION:
+    case SDL_FINGERUP:
+      event.kind = e.type == SDL_FINGERDOWN   ? InputEvent::Kind::touchDown
+                   : e.type == SDL_FINGERUP ? InputEvent::Kind::touchUp
+                                            : InputEvent::Kind::touchMove;
+      event.touch = e.tfinger.touchId;
+      event.finger = e.tfinger.fingerId;
+      event.x = e.tfinger.x;
+      event.y = e.tfinger.y;
+      return event;
+    case SDL_MOUSEBUTTONDOWN:
+    case SDL_MOUSEBUTTONUP:
+      if (e.button.which == SDL_TOUCH_MOUSEID) return std::nullopt;  // a touch's echo
+      event = mouseEvent(e.type == SDL_MOUSEBUTTONDOWN ? InputEvent::Kind::mouseDown : InputEvent::Kind::mouseUp,
+                         e.button.x, e.button.y, size);
+      event.button = e.button.button == SDL_BUTTON_LEFT ? 1 : e.button.button == SDL_BUTTON_MIDDLE ? 2 : 3;
+      return event;
+    case SDL_MOUSEMOTION:
+      if (e.motion.which == SDL_TOUCH_MOUSEID) return std::nullopt;
+      return mouseEvent(InputEvent::Kind::mouseMove, e.motion.x, e.motion.y, size);
+    case SDL_MOUSEWHEEL:
+      if (e.wheel.which == SDL_TOUCH_MOUSEID) return std::nullopt;
+      event.kind = InputEvent::Kind::wheel;
+      event.wheel = e.wheel.y * (e.wheel.direction == SDL_MOUSEWHEEL_FLIPPED ? -1.0 : 1.0);
+      return event;
+    case SDL_WINDOWEVENT:
+      if (e.window.event != SDL_WINDOWEVENT_FOCUS_LOST) return std::nullopt;
+      event.kind = InputEvent::Kind::focusLost;
+      return event;
+    default: return std::nullopt;
+  }
+}
+
+KeyAction keyAction(SDL_Keycode key, bool ctrl) {
+  switch (key) {
+    case SDLK_SPACE: return KeyAction::pause;
+    case SDLK_n:
+    case SDLK_PERIOD: return KeyAction::step;
+    case SDLK_r: return KeyAction::reset;
+    case SDLK_u: return KeyAction::undo;
+    case SDLK_z: return ctrl ? KeyAction::undo : KeyAction::none;
+    case SDLK_p:
+    case SDLK_F12: return KeyAction::screenshot;
+    case SDLK_1: return KeyAction::sticky;
+    case SDLK_2: return KeyAction::cut;
+    case SDLK_3: return KeyAction::create;
+    case SDLK_v: return KeyAction::plane;
+    case SDLK_h:
+    case SDLK_F1: return KeyAction::help;
+    case SDLK_TAB: return KeyAction::panels;
+    case SDLK_s: return ctrl ? KeyAction::save : KeyAction::none;
+    case SDLK_o: return ctrl ? KeyAction::load : KeyAction::none;
+    case SDLK_q: return ctrl ? KeyAction::quit : KeyAction::none;
+    case SDLK_ESCAPE: return KeyAction::quit;
+    default: return KeyAction::none;
+  }
+}
+
+std::string screenshotName() {
+  for (int n = 1; n < 100000; ++n) {
+    char name[64];
+    std::snprintf(name, sizeof name, "drape-screenshot-%03d.png", n);
+    if (!std::filesystem::exists(name)) return name;
+  }
+  return "drape-screenshot.png";
+}
+
+// Reads back the window (scene and panels) and writes it as PNG. Returns a message for the HUD.
+std::string screenshot(const render::Renderer& renderer, const WindowSize& size, const std::string& file) {
+  try {
+    scene::writeFileAtomically(file, cli::encodePng(renderer.readPixels(size.pixelsWide, size.pixelsHigh),
+                                                    size.pixelsWide, size.pixelsHigh));
+    return "screenshot: " + file;
+  } catch (const scene::InputError& error) {
+    return error.what();
+  }
+}
+
+}  // namespace
+
+int runApp(const AppOptions& options) {
+  // Touches must not also arrive as mouse events, nor the mouse as touches.
+  SDL_SetHint(SDL_HINT_TOUCH_MOUSE_EVENTS, "0");
+  SDL_SetHint(SDL_HINT_MOUSE_TOUCH_EVENTS, "0");
+
+  std::unique_ptr<Session> session;
+  std::optional<interact::GestureScript> script;
+  try {
+    session = std::make_unique<Session>(options.scene);
+    if (options.replay) script = scene::loadGesture(*options.replay);
+  } catch (const scene::InputError& error) {
+    std::cerr << "drape: error: " << error.what() << "\n";
+    return 2;
+  }
+
+  const auto set = [](const char* name) { return std::getenv(name) && *std::getenv(name); };
+  if (!set("DISPLAY") && !set("WAYLAND_DISPLAY") && !set("SDL_VIDEODRIVER")) {
+    // Asking SDL would probe every driver (and libraries print their complaints): say it once.
+    std::cerr << "drape: no display: set DISPLAY (X11) or WAYLAND_DISPLAY (drape-cli render draws scenes without one)\n";
+    return kExitNoDisplay;
+  }
+  if (SDL_Init(SDL_INIT_VIDEO | SDL_INIT_TIMER) != 0) {
+    std::cerr << "drape: no display: " << SDL_GetError() << " (drape-cli render draws scenes without one)\n";
+    return kExitNoDisplay;
+  }
+  // With no display SDL falls back to drivers that draw nowhere: that is no display, unless asked for.
+  const std::string driver = SDL_GetCurrentVideoDriver() ? SDL_GetCurrentVideoDriver() : "";
+  if ((driver == "offscreen" || driver == "dummy") && !std::getenv("SDL_VIDEODRIVER")) {
+    std::cerr << "drape: no display: set DISPLAY (X11) or WAYLAND_DISPLAY (drape-cli render draws scenes without one)\n";
+    SDL_Quit();
+    return kExitNoDisplay;
+  }
+  SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);
+  SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 3);
+  SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_CORE);
+  SDL_GL_SetAttribute(SDL_GL_DOUBLEBUFFER, 1);
+  SDL_GL_SetAttribute(SDL_GL_DEPTH_SIZE, 24);
+  SDL_Window* window =
+      SDL_CreateWindow("Drape", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, options.width, options.height,
+                       SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+  SDL_GLContext context = window ? SDL_GL_CreateContext(window) : nullptr;
+  if (!context) {
+    std::cerr << "drape: no display: cannot open a window with OpenGL 3.3 core: " << SDL_GetError()
+              << " (drape-cli render draws scenes without one)\n";
+    if (window) SDL_DestroyWindow(window);
+    SDL_Quit();
+    return kExitNoDisplay;
+  }
+  SDL_GL_MakeCurrent(window, context);
+  // A replay runs one step per frame, as fast as it can: frames, not seconds, are its clock.
+  SDL_GL_SetSwapInterval(script ? 0 : 1);
+
+  int exitCode = 0;
+  {
+    std::unique_ptr<render::Renderer> renderer;
+    try {
+      renderer = std::make_unique<render::Renderer>(reinterpret_cast<render::GetProcAddress>(SDL_GL_GetProcAddress));
+    } catch (const render::RenderError& error) {
+      std::cerr << "drape: no display: " << error.what() << "\n";
+      SDL_GL_DeleteContext(context);
+      SDL_DestroyWindow(window);
+      SDL_Quit();
+      return kExitNoDisplay;
+    }
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini written into the working folder
+    ImGui::StyleColorsDark();
+    ImGui_ImplSDL2_InitForOpenGL(window, context);
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+
+    ImGuiMouse imguiMouse;
+    PanelState panels;
+    FrameStats stats;
+    FixedStepper stepper;
+    interact::GestureScript recording;
+    recording.camera = session->camera();
+    std::optional<TouchReplay> replay;
+    if (script) {
+      replay.emplace(std::move(*script));
+      const interact::GestureScript& s = replay->script();
+      session->interaction().settings() = s.settings;
+      session->interaction().settings().material = scene::drawnClothTemplate(session->scene());
+      if (s.camera) session->camera() = *s.camera;
+    }
+    std::unique_ptr<InputMapper> input;
+    interact::Interaction* mapped = nullptr;
+    const auto remap = [&] {
+      // A new session (load, reset) has a new interaction: the input layer and the recorder follow it.
+      if (mapped == &session->interaction()) return;
+      mapped = &session->interaction();
+      input = std::make_unique<InputMapper>(session->interaction(), session->camera());
+      if (options.record) {
+        Session* s = session.get();
+        session->interaction().record = [s, &recording](const interact::GestureEvent& e) {
+          interact::GestureEvent timed = e;
+          timed.time = s->world().time();
+          if (recording.events.empty() || recording.events.back().time <= timed.time) recording.events.push_back(timed);
+        };
+      }
+    };
+    remap();
+
+    std::int64_t frame = 0;
+    bool running = true;
+    Clock::time_point last = Clock::now();
+    while (running) {
+      const Clock::time_point now = Clock::now();
+      const double elapsed = std::chrono::duration<double>(now - last).count();
+      last = now;
+      WindowSize size = sizeOf(window);
+      session->interaction().setCamera(session->camera(), size.aspect());
+      if (replay) replay->beforeStep(window, *session, *input, size.aspect());
+
+      bool stepOnce = false;
+      SDL_Event event;
+      while (SDL_PollEvent(&event)) {
+        const bool touch = event.type == SDL_FINGERDOWN || event.type == SDL_FINGERMOTION || event.type == SDL_FINGERUP;
+        if (!touch) ImGui_ImplSDL2_ProcessEvent(&event);
+        if (event.type == SDL_QUIT) running = false;
+        if (event.type == SDL_MOUSEBUTTONDOWN && event.button.which != SDL_TOUCH_MOUSEID) {
+          imguiMouse.press(event.button.button);
+        }
+        if (event.type == SDL_KEYDOWN && !ImGui::GetIO().WantCaptureKeyboard) {
+          const KeyAction action = keyAction(event.key.keysym.sym, (event.key.keysym.mod & KMOD_CTRL) != 0);
+          if (action == KeyAction::quit) running = false;
+          if (action == KeyAction::step) stepOnce = true;
+          if (action == KeyAction::screenshot && size.drawable()) panels.wantScreenshot = true;
+          applyKey(action, *session, panels);
+          remap();
+        }
+        size = sizeOf(window);
+        if (const std::optional<InputEvent> input_event = translate(event, size)) {
+          const bool overUi = ImGui::GetIO().WantCaptureMouse && !touch;
+          input->handle(*input_event, overUi);
+        }
+      }
+
+      // Simulate: whole steps at the scene's dt, paced by the wall clock (one per frame in a replay).
+      const double dt = session->world().settings().solver.dt;
+      int steps = replay ? 1 : session->paused ? (stepOnce ? 1 : 0) : stepper.advance(elapsed, dt);
+      if (session->paused) stepper.reset();
+      const Clock::time_point simStart = Clock::now();
+      for (int i = 0; i < steps; ++i) {
+        if (session->step() == sim::StepStatus::diverged) {
+          if (options.exitAfter) exitCode = 1;
+          break;
+        }
+      }
+      stats.simulation(std::chrono::duration<double>(Clock::now() - simStart).count(), steps, stepper.fellBehind());
+
+      // Draw: the scene, then the panels over it. A minimised or zero-size window draws nothing.
+      const Clock::time_point drawStart = Clock::now();
+      if (size.drawable()) {
+        render::FrameOptions frameOptions = panels.frameOptions;
+        renderer->render(session->world(), session->camera(), size.pixelsWide, size.pixelsHigh, frameOptions,
+                         fingerOverlay(*session));
+        renderer->finish();
+        const Clock::time_point panelStart = Clock::now();
+        stats.sceneSeconds = std::chrono::duration<double>(panelStart - drawStart).count();
+        ImGui_ImplOpenGL3_NewFrame();
+        imguiMouse.newFrame(window, size, elapsed);
+        ImGui::NewFrame();
+        const std::optional<std::filesystem::path> toLoad = drawPanels(*session, panels, stats, *input);
+        ImGui::Render();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (toLoad) {
+          session->load(*toLoad);  // on failure the message is in the status line and the scene stays
+          remap();
+        }
+        if (options.screenshotAfter && frame + 1 == *options.screenshotAfter && options.screenshotFile) {
+          const std::string said = screenshot(*renderer, size, *options.screenshotFile);
+          if (said.rfind("screenshot: ", 0) != 0) {
+            std::cerr << "drape: error: " << said << "\n";
+            exitCode = 2;
+          }
+        }
+        if (panels.wantScreenshot) {
+          session->status = screenshot(*renderer, size, screenshotName());
+          panels.wantScreenshot = false;
+        }
+        renderer->finish();
+        const Clock::time_point swapStart = Clock::now();
+        stats.panelSeconds = std::chrono::duration<double>(swapStart - panelStart).count();
+        SDL_GL_SwapWindow(window);
+        stats.swapSeconds = std::chrono::duration<double>(Clock::now() - swapStart).count();
+      } else {
+        SDL_Delay(16);  // nothing to draw: do not spin
+      }
+      stats.drawing(std::chrono::duration<double>(Clock::now() - drawStart).count(), elapsed);
+
+      ++frame;
+      if (options.exitAfter && frame >= *options.exitAfter) running = false;
+    }
+
+    if (options.out) {
+      try {
+        scene::writeFileAtomically(*options.out, scene::stateDocument(session->scene(), session->world())
+                                                         .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                                                     "\n");
+      } catch (const scene::InputError& error) {
+        std::cerr << "drape: error: " << error.what() << "\n";
+        exitCode = 2;
+      }
+    }
+    if (options.record) {
+      try {
+        scene::writeFileAtomically(*options.record, scene::gestureDocument(recording).dump(1) + "\n");
+      } catch (const scene::InputError& error) {
+        std::cerr << "drape: error: " << error.what() << "\n";
+        exitCode = 2;
+      }
+    }
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplSDL2_Shutdown();
+    ImGui::DestroyContext();
+  }
+  SDL_GL_DeleteContext(context);
+  SDL_DestroyWindow(window);
+  SDL_Quit();
+  return exitCode;
+}
+
+}  // namespace drape::app

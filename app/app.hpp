@@ -1,0 +1,29 @@
+// The desktop app: an SDL2 window with a GL 3.3 core context, the engine at a fixed step, the
+// renderer, and Dear ImGui panels on top. docs/app.md lists what it does and how to drive it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace drape::app {
+
+// Exit codes, as drape-cli's: 0 ok, 1 the simulation diverged (only with --exit-after), 2 bad input,
+// 3 internal error; and 4: no display (or no GL 3.3 context on it).
+inline constexpr int kExitNoDisplay = 4;
+
+struct AppOptions {
+  std::string scene = "hang";                 // a scene (path or shipped name) or a snapshot (*.drape.json)
+  std::optional<std::string> replay;          // gesture script, pushed through SDL as touch events
+  std::optional<std::string> record;          // write what the fingers did here at exit
+  std::optional<std::int64_t> screenshotAfter;  // frames
+  std::optional<std::string> screenshotFile;
+  std::optional<std::int64_t> exitAfter;      // frames
+  std::optional<std::string> out;             // final state (JSON) at exit, as drape-cli run --out
+  int width = 1280;
+  int height = 800;
+};
+
+int runApp(const AppOptions& options);
+
+}  // namespace drape::app

@@ -1,0 +1,90 @@
+// The app's input layer: touch and mouse events in, fingers and camera moves out.
+//
+// Events are the app's own (sdl_events.cpp translates SDL's one to one), so this layer is a pure
+// function of the events and the camera and is tested without a window. Bindings (docs/app.md):
+//   touch          every touch is a sticky finger (or draws, or cuts, in those modes); many at once
+//   left drag      a finger; with Shift held at the press it stays down when the button is released
+//   Ctrl + left    lifts the parked (Shift) finger nearest the pointer
+//   wheel          lifts the finger being dragged, or the last parked one; with none, zooms
+//   right drag     orbits the camera; middle drag pans it
+// A press over a panel (the UI wants the mouse) goes to the panel, not the cloth.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "drape/interact/interaction.hpp"
+#include "drape/render/camera.hpp"
+
+namespace drape::app {
+
+struct InputEvent {
+  enum class Kind : std::uint8_t { touchDown, touchMove, touchUp, mouseDown, mouseMove, mouseUp, wheel, focusLost };
+  Kind kind = Kind::mouseMove;
+  std::int64_t touch = 0;   // the touch device
+  std::int64_t finger = 0;  // the touch on it (SDL reuses these ids once a touch ends)
+  double x = 0.0, y = 0.0;  // normalised to the window: 0..1 from the top left, not clamped
+  int button = 0;           // 1 left, 2 middle, 3 right
+  bool shift = false;
+  bool ctrl = false;
+  double wheel = 0.0;       // notches, positive away from the user
+};
+
+struct InputOptions {
+  double wheelLift = 0.02;      // m per wheel notch
+  double orbitSpeed = 4.0;      // rad per window width dragged
+  double zoomPerNotch = 1.1;    // distance divided by this per notch towards the scene
+  double parkedReach = 0.05;    // a Ctrl-click lifts a parked finger this close (window widths)
+};
+
+class InputMapper {
+ public:
+  InputMapper(interact::Interaction& interaction, render::Camera& camera, InputOptions options = {});
+
+  void handle(const InputEvent& event, bool uiWantsMouse);
+
+  int touchesDown() const { return static_cast<int>(touchIds_.size()); }
+  // The engine finger a touch is, while it is down.
+  std::optional<int> touchFinger(std::int64_t touch, std::int64_t finger) const {
+    const auto found = touchIds_.find({touch, finger});
+    return found == touchIds_.end() ? std::nullopt : std::optional<int>(found->second);
+  }
+  int parkedFingers() const { return static_cast<int>(parked_.size()); }
+  bool dragging() const { return drag_ != Drag::none; }
+  // Events that could not be honoured (an up for a touch that is not down), newest last.
+  const std::vector<std::string>& problems() const { return problems_; }
+
+  // The engine ids fingers get: touches count up from 1, mouse fingers from kMouseIds.
+  static constexpr int kMouseIds = 1 << 24;
+
+ private:
+  enum class Drag : std::uint8_t { none, finger, orbit, pan };
+  struct Parked {
+    int id;
+    double x, y;  // where it was left, in window coordinates
+    double height;
+  };
+
+  void report(std::string problem);
+  void liftBy(int id, double& height, double notches);
+
+  interact::Interaction& interaction_;
+  render::Camera& camera_;
+  InputOptions options_;
+  std::map<std::pair<std::int64_t, std::int64_t>, int> touchIds_;
+  int nextTouchId_ = 1;
+  int nextMouseId_ = kMouseIds;
+  Drag drag_ = Drag::none;
+  int dragFinger_ = 0;
+  bool parkOnRelease_ = false;
+  double dragHeight_ = 0.0;
+  double lastX_ = 0.0, lastY_ = 0.0;
+  std::vector<Parked> parked_;
+  std::vector<std::string> problems_;
+};
+
+}  // namespace drape::app

@@ -1,0 +1,49 @@
+// drape: the desktop app. `drape --help` lists its options; docs/app.md its bindings.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "app.hpp"
+
+int main(int argc, char** argv) {
+  drape::app::AppOptions options;
+  CLI::App cli{"drape: an interactive cloth simulator you touch"};
+  cli.add_option("scene", options.scene, "Scene file, shipped scene name, or snapshot (*.drape.json); default hang");
+  cli.add_option("--replay", options.replay, "Play this gesture script as touch events pushed through SDL");
+  cli.add_option("--record", options.record, "At exit, write what the fingers did as a gesture script");
+  std::vector<std::string> screenshot;
+  cli.add_option("--screenshot-after", screenshot, "N FILE: after frame N, write the window to FILE (PNG)")
+      ->expected(2);
+  cli.add_option("--exit-after", options.exitAfter, "Quit after N frames")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000000}));
+  cli.add_option("--out", options.out, "At exit, write the final state (JSON, as drape-cli run --out)");
+  cli.add_option("--width", options.width, "Window width in points")->check(CLI::Range(64, 16384));
+  cli.add_option("--height", options.height, "Window height in points")->check(CLI::Range(64, 16384));
+  try {
+    cli.parse(argc, argv);
+    if (!screenshot.empty()) {
+      std::size_t used = 0;
+      long long frames = 0;
+      try {
+        frames = std::stoll(screenshot[0], &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != screenshot[0].size() || frames < 1) {
+        throw CLI::ValidationError("--screenshot-after", screenshot[0] + ": expected a frame count of at least 1");
+      }
+      options.screenshotAfter = frames;
+      options.screenshotFile = screenshot[1];
+    }
+  } catch (const CLI::ParseError& error) {
+    if (error.get_exit_code() == 0) return cli.exit(error);
+    std::cerr << "drape: error: " << error.what() << " (see drape --help)\n";
+    return 2;
+  }
+  try {
+    return drape::app::runApp(options);
+  } catch (const std::exception& error) {
+    std::cerr << "drape: internal error: " << error.what() << "\n";
+    return 3;
+  }
+}

@@ -1,0 +1,77 @@
+// The Dear ImGui panels, the HUD and the help overlay, and what keys do. No SDL here.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drape/render/renderer.hpp"
+#include "input.hpp"
+#include "session.hpp"
+
+namespace drape::app {
+
+enum class KeyAction : std::uint8_t {
+  none, pause, step, reset, undo, screenshot, sticky, cut, create, plane, help, panels, save, load, quit
+};
+
+// A fixed-length history for the plots.
+class History {
+ public:
+  static constexpr int kLength = 240;
+  void add(float value);
+  const float* data() const { return values_.data(); }
+  int offset() const { return next_; }
+  float latest() const { return values_[static_cast<std::size_t>((next_ + kLength - 1) % kLength)]; }
+  float largest() const;
+
+ private:
+  std::array<float, kLength> values_{};
+  int next_ = 0;
+};
+
+struct FrameStats {
+  double simulationSeconds = 0.0;  // wall time of the last frame's steps
+  int steps = 0;
+  bool fellBehind = false;
+  double drawSeconds = 0.0;
+  double sceneSeconds = 0.0, panelSeconds = 0.0, swapSeconds = 0.0;  // parts of drawing
+  double frameSeconds = 1.0 / 60.0;
+  History fps, stepMilliseconds, drawMilliseconds;
+
+  void simulation(double seconds, int stepsTaken, bool behind);
+  void drawing(double seconds, double frame);
+};
+
+struct PanelState {
+  bool showHelp = false;
+  bool showPanels = true;
+  bool wantScreenshot = false;
+  std::string file = "drape-save.drape.json";  // save and load
+  // Software GL (llvmpipe) pays for every sample and shadow tap: the app starts light (measured at
+  // 1280 x 800 on 2 cores: 4x MSAA cost 35 ms a frame, a 2048^2 shadow map 10 ms more than 1024^2).
+  render::FrameOptions frameOptions = [] {
+    render::FrameOptions options;
+    options.multisample = false;
+    options.shadowSoftness = 1;
+    options.shadowMapSize = 1024;
+    return options;
+  }();
+  History maxStrain, meanStrain, energy;
+  std::vector<History> stages;  // per stage of the world's pipeline, ms per frame
+  std::vector<std::string> stageNames;
+};
+
+// Applies a key's action to the session (pause, reset, undo, modes, ...).
+void applyKey(KeyAction action, Session& session, PanelState& panels);
+
+// Draws the panels, the HUD and the help; returns a file to load when the user picked one.
+std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& panels, FrameStats& stats,
+                                                const InputMapper& input);
+
+// Rings for sticky fingers, paths for cuts and outlines being drawn.
+render::Overlay fingerOverlay(Session& session);
+
+}  // namespace drape::app

@@ -1,0 +1,156 @@
+#include "session.hpp"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/render/renderer.hpp"
+#include "drape/scene/error.hpp"
+#include "drape/scene/output.hpp"
+#include "drape/scene/snapshot.hpp"
+
+namespace drape::app {
+
+int FixedStepper::advance(double elapsed, double dt) {
+  if (!(elapsed > 0.0) || !std::isfinite(elapsed) || !(dt > 0.0)) return 0;
+  accumulator_ += elapsed;
+  const double wanted = std::floor(accumulator_ / dt);
+  const int steps = static_cast<int>(std::min<double>(wanted, maxSteps_));
+  accumulator_ -= steps * dt;
+  fellBehind_ = wanted > maxSteps_;
+  if (fellBehind_) accumulator_ = 0.0;
+  return steps;
+}
+
+namespace {
+
+bool isSnapshot(const std::filesystem::path& file) {
+  const std::string name = file.filename().string();
+  return name.size() > 11 && name.substr(name.size() - 11) == ".drape.json";
+}
+
+}  // namespace
+
+Session::Session(const std::filesystem::path& scene) {
+  if (const std::optional<std::string> error = load(scene)) throw scene::InputError(*error);
+}
+
+void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const std::filesystem::path& path) {
+  scene_ = std::move(scene);
+  world_ = std::move(world);
+  path_ = path;
+  interaction_ = std::make_unique<interact::Interaction>(*world_);
+  interaction_->settings().material = scene::drawnClothTemplate(scene_);
+  interaction_->beforeCut = [this] { undo_.push_back({Undo::Kind::cut, world_->cloths()}); };
+  undo_.clear();
+  spawnedBefore_ = 0;
+  frame();
+}
+
+void Session::frame() {
+  glm::dvec3 lower, upper;
+  render::sceneBounds(*world_, lower, upper);
+  camera_ = render::Camera::framing(lower, upper, 0.6, 0.45, 16.0 / 10.0);
+}
+
+std::optional<std::string> Session::load(const std::filesystem::path& file) {
+  try {
+    if (isSnapshot(file)) {
+      scene::Snapshot snapshot = scene::loadSnapshot(file);
+      auto world = std::make_unique<sim::World>(scene::makeWorld(snapshot));
+      adopt(std::move(snapshot.scene), std::move(world), file);
+      status = "loaded " + file.string();
+      return std::nullopt;
+    }
+    scene::Scene loaded = scene::loadScene(scene::resolveScenePath(file.string()));
+    std::unique_ptr<sim::World> world;
+    try {
+      world = std::make_unique<sim::World>(loaded.world);
+    } catch (const std::invalid_argument& error) {
+      throw scene::InputError(loaded.source + ": " + error.what());
+    }
+    adopt(std::move(loaded), std::move(world), file);
+    status = "loaded " + scene_.name;
+    return std::nullopt;
+  } catch (const scene::InputError& error) {
+    status = error.what();
+    return status;
+  }
+}
+
+std::optional<std::string> Session::save(const std::filesystem::path& file) const {
+  try {
+    scene::writeFileAtomically(file, scene::snapshotDocument(scene_, *world_).dump() + "\n");
+    return std::nullopt;
+  } catch (const scene::InputError& error) {
+    return std::string(error.what());
+  }
+}
+
+void Session::reset() {
+  const sim::WorldSettings tuned = world_->settings();
+  if (isSnapshot(path_)) {
+    load(path_);
+  } else {
+    auto world = std::make_unique<sim::World>(scene_.world);
+    const render::Camera keep = camera_;
+    adopt(scene_, std::move(world), path_);
+    camera_ = keep;
+  }
+  tune(tuned);
+  status = "reset";
+}
+
+std::optional<std::string> Session::tune(const sim::WorldSettings& settings) {
+  try {
+    world_->tune(settings);
+    return std::nullopt;
+  } catch (const std::invalid_argument& error) {
+    status = std::string("not applied: ") + error.what();
+    return status;
+  }
+}
+
+sim::StepStatus Session::step() {
+  const int spawned = interaction_->spawnedCount();
+  if (spawned > spawnedBefore_) undo_.push_back({Undo::Kind::spawn, {}});
+  spawnedBefore_ = spawned;
+  interaction_->update(world_->settings().solver.dt);
+  const sim::StepStatus result = world_->step();
+  if (result == sim::StepStatus::diverged) {
+    const sim::Divergence d = *world_->divergence();
+    status = "diverged at step " + std::to_string(d.step) + " (cloth " + std::to_string(d.cloth) + " particle " +
+             std::to_string(d.particle) + "): back to the last good state, paused";
+    interaction_->cancelAll();
+    world_->clearDivergence();
+    paused = true;
+  }
+  return result;
+}
+
+bool Session::undo() {
+  // Spawns made since the last step are on the interaction's list but not yet on ours.
+  if (interaction_->spawnedCount() > spawnedBefore_) {
+    undo_.push_back({Undo::Kind::spawn, {}});
+    spawnedBefore_ = interaction_->spawnedCount();
+  }
+  if (undo_.empty()) {
+    status = "nothing to undo";
+    return false;
+  }
+  Undo last = std::move(undo_.back());
+  undo_.pop_back();
+  if (last.kind == Undo::Kind::spawn) {
+    interaction_->cancelAll();
+    interaction_->undoSpawn();
+    spawnedBefore_ = interaction_->spawnedCount();
+    status = "took back the last drawn cloth";
+  } else {
+    interaction_->cancelAll();
+    world_->restoreCloths(std::move(last.cloths));
+    status = "took back the last cut";
+  }
+  return true;
+}
+
+}  // namespace drape::app

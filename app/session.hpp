@@ -1,0 +1,84 @@
+// What the app holds, apart from its window: the scene, the world, the fingers' interaction, the
+// camera, undo, and the fixed-step clock. No SDL, no GL: tested without a window.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drape/interact/interaction.hpp"
+#include "drape/render/camera.hpp"
+#include "drape/scene/scene.hpp"
+#include "drape/sim/world.hpp"
+
+namespace drape::app {
+
+// A fixed step driven by a wall clock: elapsed time accumulates and is spent in whole steps, at most
+// `maxSteps` per frame. A frame slower than that drops the rest (the simulation runs slower than
+// real time instead of spiralling: each frame catching up would take longer than the last).
+class FixedStepper {
+ public:
+  explicit FixedStepper(int maxSteps = 4) : maxSteps_(maxSteps) {}
+  // Steps to take now for `elapsed` seconds of wall time at step `dt`.
+  int advance(double elapsed, double dt);
+  bool fellBehind() const { return fellBehind_; }  // the last advance dropped time
+  void reset() { accumulator_ = 0.0; }
+
+ private:
+  int maxSteps_;
+  double accumulator_ = 0.0;
+  bool fellBehind_ = false;
+};
+
+class Session {
+ public:
+  // Throws scene::InputError when the scene cannot be loaded.
+  explicit Session(const std::filesystem::path& scene);
+
+  // Loads another scene (or a snapshot, *.drape.json). On failure returns the message and keeps
+  // everything as it was.
+  std::optional<std::string> load(const std::filesystem::path& file);
+  // Writes the scene and every cloth as it is now; returns a message on failure.
+  std::optional<std::string> save(const std::filesystem::path& file) const;
+  // Back to the scene's start (the tuning the panels changed is kept).
+  void reset();
+  // Applies changed settings (from the panels); returns a message when they are refused.
+  std::optional<std::string> tune(const sim::WorldSettings& settings);
+
+  // One step of the world, fingers first. On a divergence the world is back at its last good state,
+  // the session pauses and says so in `status`.
+  sim::StepStatus step();
+
+  // Takes back the last cloth drawn or the last cut. False when there is nothing to take back.
+  bool undo();
+
+  const scene::Scene& scene() const { return scene_; }
+  sim::World& world() { return *world_; }
+  const sim::World& world() const { return *world_; }
+  interact::Interaction& interaction() { return *interaction_; }
+  render::Camera& camera() { return camera_; }
+  const std::filesystem::path& path() const { return path_; }
+
+  bool paused = false;
+  std::string status;  // the last thing worth telling the user (shown in the HUD)
+
+ private:
+  struct Undo {
+    enum class Kind : std::uint8_t { spawn, cut } kind;
+    std::vector<sim::Cloth> cloths;  // cut: the cloths before it
+  };
+  void adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const std::filesystem::path& path);
+  void frame();
+
+  scene::Scene scene_;
+  std::filesystem::path path_;
+  std::unique_ptr<sim::World> world_;
+  std::unique_ptr<interact::Interaction> interaction_;
+  render::Camera camera_;
+  std::vector<Undo> undo_;
+  int spawnedBefore_ = 0;
+};
+
+}  // namespace drape::app

@@ -1,0 +1,209 @@
+// The real app in a virtual X display (Xvfb): touch events pushed through SDL by --replay, the
+// mouse driven by xdotool, windows resized and minimised, and what it wrote checked.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <stb/stb_image.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+struct Result {
+  int exitCode;
+  std::string err;
+};
+
+class App : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    directory_ = fs::temp_directory_path() / ("drape-app-test-" + std::string(test->name()) + "-" + std::to_string(::getpid()));
+    fs::remove_all(directory_);
+    fs::create_directories(directory_);
+  }
+  void TearDown() override { fs::remove_all(directory_); }
+
+  fs::path file(const std::string& name) const { return directory_ / name; }
+
+  // Runs `script` (sh) inside a fresh virtual display, with $DRAPE the app, in the test's folder.
+  Result inDisplay(const std::string& script) const {
+    const fs::path body = file("script.sh"), err = file("stderr.txt");
+    std::ofstream(body) << "set -e\ncd '" << directory_.string() << "'\n" << script << "\n";
+    const std::string command = "DRAPE='" + std::string(DRAPE_APP) + "' DRAPE_ASSETS='" + std::string(DRAPE_ASSET_DIR) +
+                                "' xvfb-run -a -s '-screen 0 1024x768x24' sh '" + body.string() + "' 2>'" +
+                                err.string() + "' >/dev/null";
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read(err)};
+  }
+
+  fs::path directory_;
+};
+
+// Share of the picture's pixels in the cloth's orange (front) or teal (back).
+double clothShare(const fs::path& png, int& width, int& height) {
+  int channels = 0;
+  unsigned char* pixels = stbi_load(png.string().c_str(), &width, &height, &channels, 4);
+  if (!pixels) return 0.0;
+  long cloth = 0;
+  for (long i = 0; i < static_cast<long>(width) * height; ++i) {
+    const int r = pixels[4 * i], g = pixels[4 * i + 1], b = pixels[4 * i + 2];
+    if ((r > 150 && g < 140 && b < 110) || (b > 100 && g > 80 && r < 90)) ++cloth;
+  }
+  stbi_image_free(pixels);
+  return static_cast<double>(cloth) / (static_cast<double>(width) * height);
+}
+
+json state(const fs::path& file) { return json::parse(read(file)); }
+
+TEST_F(App, TouchesPushedThroughSdlTearTheClothAndTheScreenshotShowsIt) {
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk-tear --replay \"$DRAPE_ASSETS/gestures/tear.json\" --width 640 --height 400 "
+      "--exit-after 200 --screenshot-after 200 shot.png --out state.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  // Torn: particles were split, so there are more than the 24 x 24 it started with.
+  EXPECT_GT(state(file("state.json"))["cloths"][0]["positions"].size(), 576u);
+  int width = 0, height = 0;
+  const double share = clothShare(file("shot.png"), width, height);
+  EXPECT_EQ(width, 640);
+  EXPECT_EQ(height, 400);
+  EXPECT_GT(share, 0.02) << "the screenshot should show the cloth";
+}
+
+TEST_F(App, AHundredFingersAtOnceAreFine) {
+  json events = json::array();
+  const auto at = [](int i) { return std::pair{0.3 + 0.04 * (i % 10), 0.35 + 0.03 * (i / 10)}; };
+  for (int i = 0; i < 100; ++i) {
+    events.push_back({{"time", 0.1}, {"type", "down"}, {"finger", i}, {"screen", {at(i).first, at(i).second}}});
+  }
+  for (int i = 0; i < 100; ++i) {
+    events.push_back(
+        {{"time", 0.6}, {"type", "move"}, {"finger", i}, {"screen", {at(i).first + 0.05, at(i).second - 0.05}}});
+  }
+  for (int i = 0; i < 100; ++i) events.push_back({{"time", 0.8}, {"type", "up"}, {"finger", i}});
+  std::ofstream(file("hundred.json")) << json{{"events", events}, {"camera", json::object()}}.dump();
+  const Result result =
+      inDisplay("\"$DRAPE\" desk --replay hundred.json --width 480 --height 320 --exit-after 80 --out state.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  for (const json& p : state(file("state.json"))["cloths"][0]["positions"]) {
+    ASSERT_TRUE(std::isfinite(p[0].get<double>()) && std::isfinite(p[1].get<double>()));
+  }
+}
+
+TEST_F(App, AMouseDragWithXdotoolMovesTheCloth) {
+  // Baseline: the same run without the drag.
+  ASSERT_EQ(inDisplay("\"$DRAPE\" desk --width 640 --height 400 --exit-after 40 --out still.json").exitCode, 0);
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk --width 640 --height 400 --exit-after 2000 --out dragged.json &\n"
+      "app=$!\n"
+      "window=$(xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
+      "sleep 1\n"
+      "xdotool mousemove --window $window 320 200 mousedown 1\n"
+      "for x in 340 360 380 400 420 440 460; do sleep 0.2; xdotool mousemove --window $window $x 200; done\n"
+      "sleep 0.5\n"
+      "xdotool mouseup 1\n"
+      "sleep 0.5\n"
+      "xdotool key --window $window Escape\n"
+      "wait $app");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto middle = [](const json& document) {
+    double x = 0.0;
+    const json& positions = document["cloths"][0]["positions"];
+    for (const json& p : positions) x += p[0].get<double>();
+    return x / static_cast<double>(positions.size());
+  };
+  // The drag went right across the picture; the camera looks at the cloth from the front right,
+  // so the cloth moved along +x (and some -z).
+  EXPECT_GT(middle(state(file("dragged.json"))) - middle(state(file("still.json"))), 0.05);
+}
+
+TEST_F(App, ResizingAndMinimisingDoNotStopIt) {
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk --width 640 --height 400 --exit-after 100000 --out state.json &\n"
+      "app=$!\n"
+      "window=$(xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
+      "xdotool windowsize $window 200 120\n"
+      "sleep 0.3\n"
+      "xdotool windowsize $window 1 1\n"
+      "sleep 0.3\n"
+      "xdotool windowminimize $window\n"
+      "sleep 0.3\n"
+      "xdotool windowunmap $window\n"
+      "sleep 0.3\n"
+      "xdotool windowmap $window windowsize $window 500 300\n"
+      "sleep 0.3\n"
+      "kill -TERM $app\n"  // SDL turns it into a quit: the app closes as if the window were closed
+      "wait $app");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(state(file("state.json"))["cloths"][0].contains("positions"));
+}
+
+TEST_F(App, RecordingWritesAScriptThatReplays) {
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk --replay \"$DRAPE_ASSETS/gestures/translate.json\" --width 480 --height 320 "
+      "--exit-after 120 --record recorded.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const json recorded = json::parse(read(file("recorded.json")));
+  int downs = 0, moves = 0, ups = 0;
+  for (const json& e : recorded["events"]) {
+    downs += e["type"] == "down";
+    moves += e["type"] == "move";
+    ups += e["type"] == "up";
+    if (e.contains("at")) {
+      EXPECT_EQ(e["at"].size(), 3u);
+    }
+  }
+  EXPECT_EQ(downs, 1);
+  EXPECT_GT(moves, 10);
+  EXPECT_EQ(ups, 1);
+  // drape-cli reads it back.
+  const std::string replay = std::string("'") + DRAPE_CLI + "' replay desk '" + file("recorded.json").string() + "' --quiet";
+  EXPECT_EQ(std::system(replay.c_str()), 0);
+}
+
+TEST_F(App, WithoutADisplayItSaysSoInOneLine) {
+  // (--exit-after only so that a failure of this test cannot hang the run.)
+  const std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER '" + std::string(DRAPE_APP) +
+                              "' desk --exit-after 30 2>'" + file("err.txt").string() + "'";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 4);
+  const std::string err = read(file("err.txt"));
+  EXPECT_EQ(err.rfind("drape: no display: ", 0), 0u) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+}
+
+TEST_F(App, ABadSceneOrScriptIsBadInput) {
+  const std::string app = std::string("'") + DRAPE_APP + "'";
+  const std::string err = file("err.txt").string();
+  int status = std::system((app + " no-such-scene 2>'" + err + "'").c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(read(file("err.txt")).find("drape: error: no-such-scene: cannot open the scene file"), std::string::npos)
+      << read(file("err.txt"));
+  std::ofstream(file("bad.json")) << R"({"events": [{"time": 0, "type": "tap"}]})";
+  status = std::system((app + " desk --replay '" + file("bad.json").string() + "' 2>'" + err + "'").c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(read(file("err.txt")).find("bad.json: events.0.type: expected one of"), std::string::npos);
+  status = std::system((app + " desk --screenshot-after x y.png 2>'" + err + "'").c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+}
+
+}  // namespace

@@ -1,0 +1,279 @@
+// The app's input layer and session as functions of events: no window, no GL.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <unistd.h>
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+#include "input.hpp"
+#include "session.hpp"
+
+namespace drape::app {
+namespace {
+
+InputEvent touch(InputEvent::Kind kind, std::int64_t finger, double x, double y) {
+  InputEvent e;
+  e.kind = kind;
+  e.touch = 7;
+  e.finger = finger;
+  e.x = x;
+  e.y = y;
+  return e;
+}
+
+InputEvent mouse(InputEvent::Kind kind, int button, double x, double y, bool shift = false, bool ctrl = false) {
+  InputEvent e;
+  e.kind = kind;
+  e.button = button;
+  e.x = x;
+  e.y = y;
+  e.shift = shift;
+  e.ctrl = ctrl;
+  return e;
+}
+
+// The desk scene, seen by the session's framing camera: the middle of the window is on the cloth.
+struct Desk {
+  Session session{"desk"};
+  InputMapper input{session.interaction(), session.camera()};
+  Desk() { session.interaction().setCamera(session.camera(), 16.0 / 10.0); }
+  std::size_t fingers() { return session.world().fingers().size(); }
+};
+
+TEST(Input, EveryTouchIsAFingerAndManyAreDownAtOnce) {
+  Desk desk;
+  for (int i = 0; i < 10; ++i) {
+    desk.input.handle(touch(InputEvent::Kind::touchDown, i, 0.4 + 0.02 * i, 0.5), false);
+  }
+  EXPECT_EQ(desk.input.touchesDown(), 10);
+  EXPECT_EQ(desk.fingers(), 10u);
+  for (int i = 0; i < 10; ++i) desk.input.handle(touch(InputEvent::Kind::touchMove, i, 0.45 + 0.02 * i, 0.45), false);
+  desk.session.step();
+  for (int i = 0; i < 10; ++i) desk.input.handle(touch(InputEvent::Kind::touchUp, i, 0.45, 0.45), false);
+  EXPECT_EQ(desk.input.touchesDown(), 0);
+  EXPECT_EQ(desk.fingers(), 0u);
+  EXPECT_TRUE(desk.input.problems().empty());
+}
+
+TEST(Input, ReusedTouchIdsMakeNewFingersAndStrayEventsAreHarmless) {
+  Desk desk;
+  desk.input.handle(touch(InputEvent::Kind::touchMove, 3, 0.5, 0.5), false);  // moves before any down
+  desk.input.handle(touch(InputEvent::Kind::touchUp, 3, 0.5, 0.5), false);    // up without down
+  ASSERT_EQ(desk.input.problems().size(), 1u);
+  EXPECT_EQ(desk.input.problems().back(), "a touch ended that never began");
+  desk.input.handle(touch(InputEvent::Kind::touchDown, 3, 0.5, 0.5), false);
+  const std::optional<int> first = desk.input.touchFinger(7, 3);
+  desk.input.handle(touch(InputEvent::Kind::touchUp, 3, 0.5, 0.5), false);
+  desk.input.handle(touch(InputEvent::Kind::touchDown, 3, 0.5, 0.5), false);  // SDL reuses the id
+  const std::optional<int> second = desk.input.touchFinger(7, 3);
+  ASSERT_TRUE(first && second);
+  EXPECT_NE(*first, *second);
+  EXPECT_EQ(desk.fingers(), 1u);
+  // A second down for a touch that is down lifts the first.
+  desk.input.handle(touch(InputEvent::Kind::touchDown, 3, 0.52, 0.5), false);
+  EXPECT_EQ(desk.fingers(), 1u);
+}
+
+TEST(Input, CoordinatesOutsideTheWindowAndNonFiniteOnesDoNotBreakAnything) {
+  Desk desk;
+  desk.input.handle(touch(InputEvent::Kind::touchDown, 1, 1.7, -0.4), false);
+  desk.input.handle(touch(InputEvent::Kind::touchMove, 1, -3.0, 4.0), false);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  desk.input.handle(touch(InputEvent::Kind::touchDown, 2, nan, 0.5), false);
+  desk.input.handle(touch(InputEvent::Kind::touchMove, 1, nan, nan), false);
+  EXPECT_EQ(desk.input.touchesDown(), 1);
+  for (int i = 0; i < 5; ++i) ASSERT_EQ(desk.session.step(), sim::StepStatus::ok);
+}
+
+TEST(Input, MouseDragIsAFingerUnlessThePanelsWantTheMouse) {
+  Desk desk;
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.5, 0.5), true);
+  EXPECT_EQ(desk.fingers(), 0u);
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.5, 0.5), false);
+  EXPECT_EQ(desk.fingers(), 1u);
+  EXPECT_FALSE(desk.session.world().fingers().front().grips.empty());
+  desk.input.handle(mouse(InputEvent::Kind::mouseMove, 0, 0.6, 0.5), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseUp, 1, 0.6, 0.5), false);
+  EXPECT_EQ(desk.fingers(), 0u);
+}
+
+TEST(Input, ShiftParksAFingerCtrlClickLiftsItAndTheWheelRaisesIt) {
+  Desk desk;
+  // Two fingers far enough apart not to pinch.
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.45, 0.5, true), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseUp, 1, 0.45, 0.5), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.58, 0.5, true), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseUp, 1, 0.58, 0.5), false);
+  EXPECT_EQ(desk.input.parkedFingers(), 2);
+  EXPECT_EQ(desk.fingers(), 2u);
+  InputEvent wheel;
+  wheel.kind = InputEvent::Kind::wheel;
+  wheel.wheel = 5.0;  // 5 notches of 2 cm: the last parked finger rises 10 cm
+  const double distance = desk.session.camera().distance;
+  const double pressedAt = desk.session.world().fingers().back().position.y;
+  desk.input.handle(wheel, false);
+  for (int i = 0; i < 30; ++i) desk.session.step();
+  EXPECT_EQ(desk.session.camera().distance, distance);
+  EXPECT_NEAR(desk.session.world().fingers().back().position.y - pressedAt, 0.1, 1e-9);
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.46, 0.5, false, true), false);  // Ctrl-click near the first
+  EXPECT_EQ(desk.input.parkedFingers(), 1);
+  EXPECT_EQ(desk.fingers(), 1u);
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.9, 0.9, false, true), false);  // nothing near
+  EXPECT_EQ(desk.input.parkedFingers(), 1);
+}
+
+TEST(Input, RightDragOrbitsAndTheWheelZoomsWhenNoFingerIsDown) {
+  Desk desk;
+  const render::Camera before = desk.session.camera();
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 3, 0.5, 0.5), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseMove, 0, 0.6, 0.5), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseUp, 3, 0.6, 0.5), false);
+  EXPECT_NEAR(desk.session.camera().yaw - before.yaw, 0.4, 1e-12);
+  InputEvent wheel;
+  wheel.kind = InputEvent::Kind::wheel;
+  wheel.wheel = 2.0;
+  desk.input.handle(wheel, false);
+  EXPECT_NEAR(desk.session.camera().distance, before.distance / 1.21, 1e-9);
+  EXPECT_EQ(desk.fingers(), 0u);
+}
+
+TEST(Input, LosingFocusMidDragLetsEverythingGo) {
+  Desk desk;
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.5, 0.5), false);
+  desk.input.handle(touch(InputEvent::Kind::touchDown, 1, 0.45, 0.5), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.55, 0.5, true), false);  // ignored: already dragging
+  EXPECT_EQ(desk.fingers(), 2u);
+  InputEvent lost;
+  lost.kind = InputEvent::Kind::focusLost;
+  desk.input.handle(lost, false);
+  EXPECT_EQ(desk.fingers(), 0u);
+  EXPECT_FALSE(desk.input.dragging());
+  // The button's release arrives later, to no finger: nothing happens.
+  desk.input.handle(mouse(InputEvent::Kind::mouseUp, 1, 0.5, 0.5), false);
+  EXPECT_EQ(desk.fingers(), 0u);
+}
+
+TEST(FixedStepper, SpendsWholeStepsAndNeverMoreThanItsCap) {
+  FixedStepper stepper(4);
+  const double dt = 0.01;
+  EXPECT_EQ(stepper.advance(0.025, dt), 2);  // 5 ms carried over
+  EXPECT_EQ(stepper.advance(0.005, dt), 1);
+  EXPECT_FALSE(stepper.fellBehind());
+  EXPECT_EQ(stepper.advance(1.0, dt), 4);  // a one-second hitch costs at most 4 steps
+  EXPECT_TRUE(stepper.fellBehind());
+  EXPECT_EQ(stepper.advance(0.0, dt), 0);  // and its debt is dropped, not paid later
+  EXPECT_EQ(stepper.advance(std::numeric_limits<double>::infinity(), dt), 0);
+}
+
+TEST(Session, ASceneThatFailsToLoadLeavesTheCurrentOneRunning) {
+  Session session("desk");
+  const sim::World* world = &session.world();
+  const std::optional<std::string> error = session.load("no-such-scene");
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->find("no-such-scene"), std::string::npos) << *error;
+  EXPECT_EQ(session.scene().name, "desk");
+  EXPECT_EQ(&session.world(), world);
+  EXPECT_EQ(session.status, *error);
+  EXPECT_FALSE(session.load("star"));
+  EXPECT_EQ(session.scene().name, "star");
+}
+
+TEST(Session, UndoTakesBackACutAndADrawnCloth) {
+  Session session("desk");
+  interact::Interaction& hand = session.interaction();
+  hand.setMode(interact::Mode::cut);
+  ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.5, 0.0, 0.0})));
+  ASSERT_TRUE(hand.move(1, interact::Pointer::at({0.5, 0.0, 0.01})));
+  ASSERT_TRUE(hand.up(1));
+  EXPECT_EQ(session.world().cloths()[0].pieceCount, 2u);
+  hand.setMode(interact::Mode::create);
+  ASSERT_TRUE(hand.down(2, interact::Pointer::at({0.5, 0.0, 0.5})));
+  for (const sim::Vec3 p : {sim::Vec3{0.8, 0.0, 0.5}, sim::Vec3{0.8, 0.0, 0.8}, sim::Vec3{0.5, 0.0, 0.8}}) {
+    ASSERT_TRUE(hand.move(2, interact::Pointer::at(p)));
+  }
+  ASSERT_TRUE(hand.up(2));
+  session.step();
+  EXPECT_EQ(session.world().cloths().size(), 2u);
+  ASSERT_TRUE(session.undo());  // the drawn cloth
+  EXPECT_EQ(session.world().cloths().size(), 1u);
+  ASSERT_TRUE(session.undo());  // the cut
+  EXPECT_EQ(session.world().cloths()[0].pieceCount, 1u);
+  EXPECT_EQ(session.world().cloths()[0].state.position.size(), 576u);
+  EXPECT_FALSE(session.undo());
+}
+
+TEST(Session, SaveAndLoadBringBackATornClothExactly) {
+  Session session("desk");
+  interact::Interaction& hand = session.interaction();
+  hand.setMode(interact::Mode::cut);
+  ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.5, 0.0, 0.1})));
+  ASSERT_TRUE(hand.move(1, interact::Pointer::at({0.5, 0.0, 0.1})));
+  ASSERT_TRUE(hand.up(1));
+  for (int i = 0; i < 10; ++i) session.step();
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("drape-session-" + std::to_string(::getpid()) + ".drape.json");
+  ASSERT_FALSE(session.save(file));
+  const sim::Cloth saved = session.world().cloths()[0];
+  Session loaded("desk");
+  ASSERT_FALSE(loaded.load(file)) << loaded.status;
+  std::filesystem::remove(file);
+  const sim::Cloth& back = loaded.world().cloths()[0];
+  EXPECT_EQ(back.rest.triangles, saved.rest.triangles);
+  EXPECT_EQ(back.state.position, saved.state.position);
+  EXPECT_EQ(back.state.mass, saved.state.mass);
+  EXPECT_EQ(back.pieceCount, 2u);
+  for (int i = 0; i < 10; ++i) ASSERT_EQ(loaded.step(), sim::StepStatus::ok);
+  // A snapshot that is not one is refused, and the session stays.
+  const std::filesystem::path bad = std::filesystem::temp_directory_path() / "drape-bad.drape.json";
+  { std::ofstream(bad) << R"({"drapeSnapshot": 1, "scene": {}, "cloths": [{"restPositions": [[0, 0, 0]], "triangles": [[0, 1, 2]]}]})"; }
+  const std::optional<std::string> error = loaded.load(bad);
+  std::filesystem::remove(bad);
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->find("cloths.0.triangles.0"), std::string::npos) << *error;
+  EXPECT_EQ(loaded.world().cloths()[0].pieceCount, 2u);
+}
+
+TEST(Session, ADivergenceIsReportedTheLastGoodStateKeptAndTheSessionPaused) {
+  Session session(std::filesystem::path(DRAPE_ASSET_DIR) / "extreme" / "stiff-springs.json");
+  sim::StepStatus status = sim::StepStatus::ok;
+  for (int i = 0; i < 600 && status == sim::StepStatus::ok; ++i) status = session.step();
+  ASSERT_EQ(status, sim::StepStatus::diverged);
+  EXPECT_TRUE(session.paused);
+  EXPECT_EQ(session.status.rfind("diverged at step ", 0), 0u) << session.status;
+  for (const sim::Vec3& x : session.world().cloths()[0].state.position) {
+    ASSERT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
+  }
+  // It is not stuck: the next step runs (and, explicit Euler being what it is, may diverge again).
+  const std::int64_t steps = session.world().stepCount();
+  session.paused = false;
+  if (session.step() == sim::StepStatus::ok) {
+    EXPECT_EQ(session.world().stepCount(), steps + 1);
+  }
+  for (const sim::Vec3& x : session.world().cloths()[0].state.position) ASSERT_TRUE(std::isfinite(x.x));
+}
+
+TEST(Session, TuningAppliesWhatItCanAndRefusesWhatItCannot) {
+  Session session("desk");
+  sim::WorldSettings tuned = session.world().settings();
+  tuned.solver.iterations = 3;
+  tuned.tearing = {true, 1.2};
+  tuned.colliders[0].friction.staticCoefficient = 0.1;
+  ASSERT_FALSE(session.tune(tuned));
+  EXPECT_EQ(session.world().settings().solver.iterations, 3);
+  EXPECT_TRUE(session.world().hasStage(sim::Stage::tear));
+  EXPECT_EQ(session.world().colliders()[0].settings().friction.staticCoefficient, 0.1);
+  tuned.solver.dt = -1.0;
+  const std::optional<std::string> refused = session.tune(tuned);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(*refused, "not applied: solver.dt must be a positive number of seconds");
+  EXPECT_GT(session.world().settings().solver.dt, 0.0);
+  tuned = session.world().settings();
+  tuned.solver.model = sim::Model::force;
+  EXPECT_TRUE(session.tune(tuned));
+}
+
+}  // namespace
+}  // namespace drape::app
