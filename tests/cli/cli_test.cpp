@@ -167,6 +167,12 @@ TEST_F(Cli, DivergenceExitsOneWithTheStepAndWritesNothing) {
   EXPECT_FALSE(fs::exists(state));
 }
 
+// A scene nested 100000 arrays deep: nothing recursive may meet it.
+const char* deeplyNested() {
+  static const std::string text = "{\"a\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+  return text.c_str();
+}
+
 struct BadInput {
   const char* name;
   const char* sceneText;  // written to bad.json; nullptr: use the valid scene
@@ -247,7 +253,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"OutlinePointNotAPair", R"({"cloths": [{"outline": {"points": [[0, 0], [1, 0], [0, 1, 2]]}}]})", "",
                  "bad.json: cloths.0.outline.points.2: expected [x, z]"},
         BadInput{"TearingAtRestLength", R"({"tearing": {"threshold": 1}})", "",
-                 "bad.json: tearing.threshold: expected a number > 1"}),
+                 "bad.json: tearing.threshold: expected a number > 1"},
+        BadInput{"NestedTooDeep", deeplyNested(), "",
+                 "bad.json: nested more than 64 levels deep"}),
     [](const auto& testInfo) { return std::string(testInfo.param.name); });
 
 TEST_F(Cli, RenderWritesAPngOfTheRequestedSize) {

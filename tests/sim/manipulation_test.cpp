@@ -300,5 +300,61 @@ TEST(Cloths, CanBeAddedAndRemovedWhileTheWorldRuns) {
   EXPECT_THROW(world.addCloth(bad), std::invalid_argument);
 }
 
+TEST(Tuning, WindPressureCanBeSwitchedOnAndOffWhileRunning) {
+  WorldSettings settings = flatSheet(9);  // weightless, no drag: at rest it stays at rest
+  World world(settings);
+  world.run(3);
+  WorldSettings windy = world.settings();
+  windy.air.pressure = 5.0;
+  windy.air.velocity = Vec3{0.0, 3.0, 0.0};
+  world.tune(windy);
+  EXPECT_TRUE(world.hasStage(Stage::windPressure));
+  world.run(10);
+  EXPECT_GT(world.cloths()[0].state.position[40].y, 1e-4);  // the wind lifted it
+  WorldSettings calm = world.settings();
+  calm.air.pressure = 0.0;
+  world.tune(calm);
+  // No outside force acts any more: the sheet's momentum stays what the wind left it (the
+  // constraints only move momentum between particles).
+  const auto momentum = [&world] {
+    Vec3 sum{0.0};
+    for (std::size_t i = 0; i < world.cloths()[0].state.position.size(); ++i) {
+      sum += world.cloths()[0].state.mass[i] * world.velocity(0, static_cast<ParticleIndex>(i));
+    }
+    return sum;
+  };
+  const Vec3 before = momentum();
+  EXPECT_GT(before.y, 1e-3);
+  world.run(10);
+  EXPECT_NEAR(glm::length(momentum() - before), 0.0, 1e-9);
+}
+
+TEST(Restore, PutsBackPositionsAndVelocitiesAndStillPins) {
+  WorldSettings settings = flatSheet(5);
+  settings.cloths[0].pins = {{0, 0, std::nullopt}};
+  World world(settings);
+  world.pressFinger(1, Vec3{0.0}, 0.01);  // carry the pin, moving
+  for (int step = 1; step <= 5; ++step) {
+    world.moveFinger(1, Vec3{0.0, 0.02 * step, 0.0});
+    world.step();
+  }
+  const std::vector<Cloth> taken = world.cloths();  // the pin is moving in the finger now
+  const Vec3 pinAt = taken[0].state.position[0];
+  World other(flatSheet(5));
+  other.restoreCloths(taken);
+  other.run(20);
+  EXPECT_EQ(other.cloths()[0].state.position[0], pinAt);  // the pin stands still
+  // A free particle kept its velocity: the restored world moves on as the original would.
+  world.releaseFinger(1);
+  world.run(1);
+  World again(flatSheet(5));
+  again.restoreCloths(taken);
+  again.run(1);
+  EXPECT_NEAR(glm::length(again.cloths()[0].state.position[12] - world.cloths()[0].state.position[12]), 0.0, 1e-3);
+  std::vector<Cloth> broken = taken;
+  broken[0].rest.triangles[0] = {0, 0, 1};
+  EXPECT_THROW(other.restoreCloths(broken), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace drape::sim

@@ -185,7 +185,7 @@ bool Interaction::move(int id, const Pointer& pointer) {
                                : touch->depth;
         if (!touch->cutStarted && beforeCut) beforeCut();
         touch->cutStarted = true;
-        world_.cut(previous, *point, depth);
+        if (world_.cut(previous, *point, depth) > 0) touch->cutSomething = true;
         touch->stroke.push_back(*point);
       }
       break;
@@ -205,6 +205,7 @@ bool Interaction::up(int id) {
   touches_.erase(touches_.begin() + (touch - touches_.data()));
   note(GestureEvent::Type::up, id);
   if (lifted.mode == Mode::sticky && lifted.holds) world_.releaseFinger(id);
+  if (lifted.mode == Mode::cut && lifted.cutStarted && !lifted.cutSomething && cutNothing) cutNothing();
   if (lifted.mode == Mode::create) return spawn(lifted);
   return true;
 }
@@ -309,6 +310,7 @@ bool Interaction::spawn(const Touch& touch) {
     cloth.pins.clear();
     cloth.mass = settings_.arealDensity * loopArea(shape.loop);
     spawnedIndex_.push_back(world_.addCloth(cloth));
+    if (afterSpawn) afterSpawn();
   } catch (const std::invalid_argument& error) {
     return fail(std::string("outline: ") + error.what());
   }

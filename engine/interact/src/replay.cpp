@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <unordered_map>
 
 namespace drape::interact {
 
@@ -36,14 +37,13 @@ double GestureScript::length() const {
 }
 
 ReplayClock::ReplayClock(const GestureScript& script) : script_(script), following_(script.events.size(), kNone) {
-  for (std::size_t i = 0; i < script.events.size(); ++i) {
+  // One pass from the end: each finger's next event is the last one seen of it.
+  std::unordered_map<int, std::size_t> next;
+  for (std::size_t i = script.events.size(); i-- > 0;) {
     if (!carriesFinger(script.events[i].type)) continue;
-    for (std::size_t j = i + 1; j < script.events.size(); ++j) {
-      if (carriesFinger(script.events[j].type) && script.events[j].finger == script.events[i].finger) {
-        following_[i] = j;
-        break;
-      }
-    }
+    const auto found = next.find(script.events[i].finger);
+    if (found != next.end()) following_[i] = found->second;
+    next[script.events[i].finger] = i;
   }
 }
 

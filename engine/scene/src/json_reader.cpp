@@ -153,7 +153,9 @@ json readJsonFile(const std::filesystem::path& file, std::string_view what) {
   // JSON allows a key twice in one object and keeps the last; a file that does so has a mistake in
   // it, so it is refused rather than silently half-read.
   std::vector<std::set<std::string>> keysSeen;
-  const json::parser_callback_t rejectDuplicateKeys = [&](int, json::parse_event_t event, json& parsed) {
+  const json::parser_callback_t rejectDuplicateKeys = [&](int depth, json::parse_event_t event, json& parsed) {
+    // Deeper than any file of ours: refused before anything recursive (printing, copying) meets it.
+    if (depth > 64) throw InputError(source + ": nested more than 64 levels deep");
     if (event == json::parse_event_t::object_start) keysSeen.emplace_back();
     if (event == json::parse_event_t::object_end && !keysSeen.empty()) keysSeen.pop_back();
     if (event == json::parse_event_t::key && !keysSeen.empty() &&

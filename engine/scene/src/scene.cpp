@@ -283,10 +283,44 @@ void applyOverride(json& document, std::string_view assignment) {
   }
 }
 
+Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator) {
+  Scene changed = scene;
+  sim::SolverSettings& solver = changed.world.solver;
+  if (model == Model::position) integrator = sim::Integrator::verlet;
+  if (solver.model != model) {
+    for (sim::ClothSettings& cloth : changed.world.cloths) {
+      for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(model, kind);
+    }
+    if (model == Model::force) solver.xpbd = solver.tethers = false;
+  }
+  solver.model = model;
+  solver.integrator = integrator;
+  // The document (what a snapshot keeps) says the same: the model, and the materials left to default.
+  json document = json::parse(changed.document, nullptr, false);
+  if (document.is_object()) {
+    json& solverDocument = document["solver"];
+    solverDocument["model"] = std::string(sim::name(model));
+    solverDocument["integrator"] = std::string(sim::name(integrator));
+    if (model == Model::force) {
+      solverDocument.erase("xpbd");
+      solverDocument.erase("tethers");
+    }
+    if (document.contains("cloths") && document["cloths"].is_array()) {
+      for (json& cloth : document["cloths"]) {
+        for (ConstraintKind kind : sim::kConstraintKinds) cloth.erase(std::string(sim::name(kind)));
+      }
+    }
+    changed.document = document.dump(-1, ' ', false, json::error_handler_t::replace);
+  }
+  return changed;
+}
+
 sim::ClothSettings drawnClothTemplate(const Scene& scene) {
   if (!scene.world.cloths.empty()) {
     sim::ClothSettings cloth = scene.world.cloths.front();
     cloth.pins.clear();
+    cloth.masses.clear();
+    cloth.outline.reset();
     cloth.initialVelocity = sim::Vec3{0.0};
     return cloth;
   }

@@ -217,11 +217,18 @@ void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_
       area[static_cast<std::size_t>(group[j])] += topology.triangleArea[fan[j]];
       total += topology.triangleArea[fan[j]];
     }
+    // Shares by area, with a floor so that a fan of degenerate (zero-area) triangles still gets a
+    // positive mass.
+    Real weights = 0.0;
+    for (Real& a : area) {
+      a += total > 0.0 ? 1e-6 * total : 1.0;
+      weights += a;
+    }
     const Real mass = s.mass[v];
     Real given = 0.0;
     for (int g = 1; g < groups && budget > 0; ++g, --budget) {
       const auto copy = static_cast<ParticleIndex>(rest.particleCount());
-      const Real share = total > 0.0 ? mass * area[static_cast<std::size_t>(g)] / total : mass / groups;
+      const Real share = mass * area[static_cast<std::size_t>(g)] / weights;
       given += share;
       rest.restPositions.push_back(rest.restPositions[v]);
       s.position.push_back(s.position[v]);

@@ -256,6 +256,19 @@ void World::buildPipeline() {
   }
   add(Stage::guard, false);
   if (settings_.tearing.enabled && !cloths_.empty()) add(Stage::tear, false);
+  if (model == Model::position) {
+    // Wind pressure's per-particle accelerations exist exactly while its stage does (tuning can
+    // switch it on or off): the integrator adds them whenever the array is there.
+    const bool wind = hasStage(Stage::windPressure);
+    for (std::size_t c = 0; c < cloths_.size() && c < scratch_.size(); ++c) {
+      std::vector<Vec3>& acceleration = scratch_[c].acceleration;
+      if (wind) {
+        acceleration.resize(cloths_[c].state.position.size(), Vec3{0.0});
+      } else {
+        acceleration.clear();
+      }
+    }
+  }
 }
 
 bool World::hasStage(Stage stage) const {
@@ -708,6 +721,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
     }
     for (const glm::uvec3& t : cloth.rest.triangles) {
       require(t.x < n && t.y < n && t.z < n, "a triangle names a particle the cloth does not have");
+      require(t.x != t.y && t.y != t.z && t.z != t.x, "a triangle names one particle twice");
     }
     for (const auto& list : cloth.rest.constraints) {
       for (const DistanceConstraint& c : list) {
@@ -727,15 +741,22 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
     Cloth& cloth = cloths_[c];
     settings_.cloths.push_back(cloth.settings);
     ParticleState& s = cloth.state;
-    // Inverse masses follow from masses and pins (no finger holds anything now).
-    for (std::size_t i = 0; i < s.mass.size(); ++i) s.inverseMass[i] = s.pinned[i] ? 0.0 : 1.0 / s.mass[i];
+    // Inverse masses follow from masses and pins (no finger holds anything now); a pin stands still
+    // (it may have been caught moving in a finger when the copy was taken).
+    for (std::size_t i = 0; i < s.mass.size(); ++i) {
+      s.inverseMass[i] = s.pinned[i] ? 0.0 : 1.0 / s.mass[i];
+      if (!s.pinned[i]) continue;
+      s.previousPosition[i] = s.position[i];
+      if (!s.velocity.empty()) s.velocity[i] = Vec3{0.0};
+    }
     cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
     held_.emplace_back(s.position.size(), 0);
     buildTethers(c);
-    if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(s.position.size(), Vec3{0.0});
     if (settings_.solver.model == Model::force) force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), scratch_[c]);
   }
   buildPipeline();
+  // The cloths come with their own history (x_prev, velocities): the next step must not restart it.
+  historyStarted_ = true;
   topologyVersion_ = nextTopologyVersion();
 }
 

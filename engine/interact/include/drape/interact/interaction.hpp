@@ -114,8 +114,12 @@ class Interaction {
   // Removes the most recently drawn cloth still in the world. False if there is none.
   bool undoSpawn();
 
-  // Called once per cut stroke, before it first cuts, so the app can take a snapshot to undo it.
+  // Called once per cut stroke, before it first cuts, so the app can take a snapshot to undo it;
+  // and when the stroke ends having cut nothing, so the snapshot can be dropped.
   std::function<void()> beforeCut;
+  std::function<void()> cutNothing;
+  // Called when a drawn cloth has been added to the world.
+  std::function<void()> afterSpawn;
   // Called after every event that took, with world pointers (where the finger went down, moved,
   // drew or cut), so a session can be recorded as a gesture script; the time is the caller's.
   std::function<void(const GestureEvent&)> record;
@@ -138,6 +142,7 @@ class Interaction {
     std::vector<Vec3> stroke;
     Vec3 depth{0.0, -1.0, 0.0};   // cut: the direction the cut surface extends along
     bool cutStarted = false;  // beforeCut was called for this stroke
+    bool cutSomething = false;
   };
 
   bool fail(std::string message);

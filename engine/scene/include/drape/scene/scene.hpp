@@ -41,6 +41,11 @@ void applyOverride(nlohmann::json& document, std::string_view assignment);
 // model's defaults when the scene has none.
 sim::ClothSettings drawnClothTemplate(const Scene& scene);
 
+// The scene with another model or integrator. Materials mean different things in the two models
+// (a 0..1 fraction, or N/m), so when the model changes every cloth takes the new model's default
+// materials, and XPBD and tethers (position model only) are switched off for the force model.
+Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator);
+
 // Finds a scene by path, or by name in the shipped scenes folder (`hang` -> assets/scenes/hang.json).
 std::filesystem::path resolveScenePath(const std::string& nameOrPath);
 std::filesystem::path sceneDirectory();
