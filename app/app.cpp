@@ -104,7 +104,7 @@ class TouchReplay {
 
   const interact::GestureScript& script() const { return script_; }
 
-  void beforeStep(SDL_Window* window, Session& session, const InputMapper& input, double aspect) {
+  void beforeStep(SDL_Window* window, Session& session, double aspect) {
     const double dt = session.world().settings().solver.dt;
     for (const interact::ReplayAction& action : clock_.advance(session.world().time(), dt)) {
       const interact::GestureEvent& e = script_.events[action.index];
@@ -113,13 +113,27 @@ class TouchReplay {
                                                : session.camera().project(action.pointer.world, aspect);
       using T = interact::GestureEvent::Type;
       const T type = action.onTheWay ? T::move : e.type;
-      const std::optional<int> id = input.touchFinger(kReplayTouch, e.finger);
       switch (type) {
         case T::down:
         case T::move:
           if (at) pushTouch(window, type == T::down ? SDL_FINGERDOWN : SDL_FINGERMOTION, e.finger, *at);
           break;
         case T::up: pushTouch(window, SDL_FINGERUP, e.finger, at.value_or(glm::dvec2{0.5})); break;
+        default: break;
+      }
+      // Everything in order: what has no touch event waits until the touches before it are handled.
+      pending_.push_back(action);
+    }
+  }
+
+  // After SDL's queue (and with it the touches pushed above) has been handled.
+  void afterEvents(Session& session, const InputMapper& input) {
+    using T = interact::GestureEvent::Type;
+    for (const interact::ReplayAction& action : pending_) {
+      const interact::GestureEvent& e = script_.events[action.index];
+      if (action.onTheWay) continue;
+      const std::optional<int> id = input.touchFinger(kReplayTouch, e.finger);
+      switch (e.type) {
         case T::pin:
           if (id) session.interaction().pin(*id);
           break;
@@ -131,13 +145,16 @@ class TouchReplay {
           break;
         case T::mode: session.interaction().setMode(e.mode); break;
         case T::plane: session.interaction().setPlane(e.plane); break;
+        default: break;
       }
     }
+    pending_.clear();
   }
 
  private:
   interact::GestureScript script_;
   interact::ReplayClock clock_;
+  std::vector<interact::ReplayAction> pending_;
 };
 
 InputEvent mouseEvent(InputEvent::Kind kind, int x, int y, const WindowSize& size) {
@@ -347,7 +364,7 @@ int runApp(const AppOptions& options) {
       last = now;
       WindowSize size = sizeOf(window);
       session->interaction().setCamera(session->camera(), size.aspect());
-      if (replay) replay->beforeStep(window, *session, *input, size.aspect());
+      if (replay) replay->beforeStep(window, *session, size.aspect());
 
       bool stepOnce = false;
       SDL_Event event;
@@ -372,6 +389,8 @@ int runApp(const AppOptions& options) {
           input->handle(*input_event, overUi);
         }
       }
+
+      if (replay) replay->afterEvents(*session, *input);
 
       // Simulate: whole steps at the scene's dt, paced by the wall clock (one per frame in a replay).
       const double dt = session->world().settings().solver.dt;
@@ -401,10 +420,8 @@ int runApp(const AppOptions& options) {
         const std::optional<std::filesystem::path> toLoad = drawPanels(*session, panels, stats, *input);
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        if (toLoad) {
-          session->load(*toLoad);  // on failure the message is in the status line and the scene stays
-          remap();
-        }
+        if (toLoad) session->load(*toLoad);  // on failure the message is in the status line and the scene stays
+        remap();  // a load, reset or model change made a new interaction
         if (options.screenshotAfter && frame + 1 == *options.screenshotAfter && options.screenshotFile) {
           const std::string said = screenshot(*renderer, size, *options.screenshotFile);
           if (said.rfind("screenshot: ", 0) != 0) {
@@ -441,6 +458,7 @@ int runApp(const AppOptions& options) {
       }
     }
     if (options.record) {
+      recording.settings = session->interaction().settings();  // radius, pinch, lift, spacing as they were
       try {
         scene::writeFileAtomically(*options.record, scene::gestureDocument(recording).dump(1) + "\n");
       } catch (const scene::InputError& error) {

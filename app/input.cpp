@@ -24,8 +24,21 @@ void InputMapper::liftBy(int id, double& height, double notches) {
   interaction_.lift(id, height);
 }
 
+void InputMapper::forgetLifted() {
+  // The session may have lifted fingers behind our back (a divergence, an undo, a reset): forget
+  // those, so the wheel does not keep lifting a finger that is gone.
+  const std::vector<interact::TouchView> down = interaction_.touches();
+  const auto isDown = [&](int id) {
+    return std::any_of(down.begin(), down.end(), [id](const interact::TouchView& t) { return t.id == id; });
+  };
+  std::erase_if(parked_, [&](const Parked& p) { return !isDown(p.id); });
+  std::erase_if(touchIds_, [&](const auto& entry) { return !isDown(entry.second); });
+  if (drag_ == Drag::finger && !isDown(dragFinger_)) drag_ = Drag::none;
+}
+
 void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
   using Kind = InputEvent::Kind;
+  forgetLifted();
   const auto key = std::make_pair(event.touch, event.finger);
   const interact::Pointer pointer = interact::Pointer::onScreen(event.x, event.y);
   switch (event.kind) {

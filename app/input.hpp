@@ -70,6 +70,7 @@ class InputMapper {
   };
 
   void report(std::string problem);
+  void forgetLifted();
   void liftBy(int id, double& height, double notches);
 
   interact::Interaction& interaction_;

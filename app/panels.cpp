@@ -196,7 +196,11 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::SameLine();
     if (ImGui::Button("step") && session.paused) session.step();
     ImGui::SameLine();
-    if (ImGui::Button("reset")) session.reset();
+    if (ImGui::Button("reset")) {
+      session.reset();  // a new world: nothing below may use the old one
+      ImGui::End();
+      return toLoad;
+    }
     ImGui::SameLine();
     if (ImGui::Button("undo")) session.undo();
     ImGui::SameLine();
@@ -236,9 +240,18 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   sim::WorldSettings tuned = world.settings();
   bool changed = false;
   if (ImGui::CollapsingHeader("Solver", ImGuiTreeNodeFlags_DefaultOpen)) {
-    ImGui::Text("model: %s%s%s", std::string(sim::name(tuned.solver.model)).c_str(),
-                tuned.solver.model == sim::Model::force ? ", integrator: " : "",
-                tuned.solver.model == sim::Model::force ? std::string(sim::name(tuned.solver.integrator)).c_str() : "");
+    // Model and integrator restart the scene (materials mean different things in the two models).
+    int model = tuned.solver.model == sim::Model::position ? 0 : 1;
+    const char* models[] = {"position (Verlet + constraints)", "force (springs)"};
+    int integrator = static_cast<int>(tuned.solver.integrator);
+    const char* integrators[] = {"explicit Euler", "symplectic Euler", "Verlet", "midpoint", "RK4"};
+    bool restart = ImGui::Combo("model", &model, models, 2);
+    if (model == 1) restart |= ImGui::Combo("integrator", &integrator, integrators, 5);
+    if (restart) {
+      session.setModel(model == 0 ? sim::Model::position : sim::Model::force, static_cast<sim::Integrator>(integrator));
+      ImGui::End();
+      return toLoad;
+    }
     changed |= sliderReal("dt (s)", tuned.solver.dt, 0.001, 0.05, "%.4f", ImGuiSliderFlags_Logarithmic);
     changed |= ImGui::SliderInt("substeps", &tuned.solver.substeps, 1, 32);
     changed |= ImGui::SliderInt("iterations", &tuned.solver.iterations, 0, 100);

@@ -42,8 +42,11 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
   interaction_ = std::make_unique<interact::Interaction>(*world_);
   interaction_->settings().material = scene::drawnClothTemplate(scene_);
   interaction_->beforeCut = [this] { undo_.push_back({Undo::Kind::cut, world_->cloths()}); };
+  interaction_->cutNothing = [this] {
+    if (!undo_.empty() && undo_.back().kind == Undo::Kind::cut) undo_.pop_back();
+  };
+  interaction_->afterSpawn = [this] { undo_.push_back({Undo::Kind::spawn, {}}); };
   undo_.clear();
-  spawnedBefore_ = 0;
   frame();
 }
 
@@ -101,6 +104,23 @@ void Session::reset() {
   status = "reset";
 }
 
+std::optional<std::string> Session::setModel(sim::Model model, sim::Integrator integrator) {
+  scene::Scene changed = scene::withModel(scene_, model, integrator);
+  try {
+    auto world = std::make_unique<sim::World>(changed.world);
+    const render::Camera keep = camera_;
+    adopt(std::move(changed), std::move(world), path_);
+    camera_ = keep;
+  } catch (const std::invalid_argument& error) {
+    status = std::string("not applied: ") + error.what();
+    return status;
+  }
+  status = "model: " + std::string(sim::name(model)) +
+           (model == sim::Model::force ? " (" + std::string(sim::name(integrator)) + ")" : std::string()) +
+           ", from the start";
+  return std::nullopt;
+}
+
 std::optional<std::string> Session::tune(const sim::WorldSettings& settings) {
   try {
     world_->tune(settings);
@@ -112,9 +132,6 @@ std::optional<std::string> Session::tune(const sim::WorldSettings& settings) {
 }
 
 sim::StepStatus Session::step() {
-  const int spawned = interaction_->spawnedCount();
-  if (spawned > spawnedBefore_) undo_.push_back({Undo::Kind::spawn, {}});
-  spawnedBefore_ = spawned;
   interaction_->update(world_->settings().solver.dt);
   const sim::StepStatus result = world_->step();
   if (result == sim::StepStatus::diverged) {
@@ -129,11 +146,6 @@ sim::StepStatus Session::step() {
 }
 
 bool Session::undo() {
-  // Spawns made since the last step are on the interaction's list but not yet on ours.
-  if (interaction_->spawnedCount() > spawnedBefore_) {
-    undo_.push_back({Undo::Kind::spawn, {}});
-    spawnedBefore_ = interaction_->spawnedCount();
-  }
   if (undo_.empty()) {
     status = "nothing to undo";
     return false;
@@ -143,7 +155,6 @@ bool Session::undo() {
   if (last.kind == Undo::Kind::spawn) {
     interaction_->cancelAll();
     interaction_->undoSpawn();
-    spawnedBefore_ = interaction_->spawnedCount();
     status = "took back the last drawn cloth";
   } else {
     interaction_->cancelAll();

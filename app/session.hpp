@@ -36,6 +36,8 @@ class Session {
  public:
   // Throws scene::InputError when the scene cannot be loaded.
   explicit Session(const std::filesystem::path& scene);
+  Session(const Session&) = delete;  // the interaction's callbacks hold on to this session
+  Session& operator=(const Session&) = delete;
 
   // Loads another scene (or a snapshot, *.drape.json). On failure returns the message and keeps
   // everything as it was.
@@ -44,6 +46,9 @@ class Session {
   std::optional<std::string> save(const std::filesystem::path& file) const;
   // Back to the scene's start (the tuning the panels changed is kept).
   void reset();
+  // Restarts the scene with another model or integrator (scene::withModel); returns a message when
+  // the scene cannot run so.
+  std::optional<std::string> setModel(sim::Model model, sim::Integrator integrator);
   // Applies changed settings (from the panels); returns a message when they are refused.
   std::optional<std::string> tune(const sim::WorldSettings& settings);
 
@@ -78,7 +83,6 @@ class Session {
   std::unique_ptr<interact::Interaction> interaction_;
   render::Camera camera_;
   std::vector<Undo> undo_;
-  int spawnedBefore_ = 0;
 };
 
 }  // namespace drape::app

@@ -275,5 +275,19 @@ TEST(Session, TuningAppliesWhatItCanAndRefusesWhatItCannot) {
   EXPECT_TRUE(session.tune(tuned));
 }
 
+TEST(Session, AnotherModelRestartsTheSceneWithThatModelsMaterials) {
+  Session session("desk");
+  ASSERT_FALSE(session.setModel(sim::Model::force, sim::Integrator::rk4)) << session.status;
+  const sim::WorldSettings& settings = session.world().settings();
+  EXPECT_EQ(settings.solver.model, sim::Model::force);
+  EXPECT_EQ(settings.solver.integrator, sim::Integrator::rk4);
+  EXPECT_EQ(settings.cloths[0].material(sim::ConstraintKind::stretch).stiffness, 2000.0);  // N/m now
+  EXPECT_FALSE(session.world().hasStage(sim::Stage::selfCollide));  // the force model has none
+  EXPECT_EQ(session.step(), sim::StepStatus::ok);
+  ASSERT_FALSE(session.setModel(sim::Model::position, sim::Integrator::rk4));
+  EXPECT_EQ(session.world().settings().solver.integrator, sim::Integrator::verlet);
+  EXPECT_EQ(session.world().settings().cloths[0].material(sim::ConstraintKind::stretch).stiffness, 1.0);
+}
+
 }  // namespace
 }  // namespace drape::app
