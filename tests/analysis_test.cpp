@@ -118,5 +118,26 @@ TEST(Stability, ThePositionModelNeverDivergesOverStiffnessAndStep) {
   }
 }
 
+// The force model's springs on the chain and the sheet bound the step as linear theory says: for
+// the chain, at 2 / omega_max with omega_max = 2 sqrt(k / m) (within the oscillator's 0.8-1.0 and a
+// grid step); for the sheet, no earlier than the Gershgorin bound allows, and not far past it.
+TEST(Stability, TheForceModelsSpringsBoundTheStepOnAChainAndASheet) {
+  for (sim::Integrator integrator : {sim::Integrator::symplecticEuler, sim::Integrator::rk4}) {
+    const double bound = *theoreticalStableOmegaDt(integrator);
+    const double k = 1000.0;
+    const auto chain = largestStableDt(PositionSystem::chain, integrator, k, 1e-4, 0.1, 1.1, 400);
+    ASSERT_TRUE(chain);
+    EXPECT_GT(*chain, 0.75 * bound / highestOmegaBound(PositionSystem::chain, k)) << sim::name(integrator);
+    EXPECT_LT(*chain, 1.1 * bound / highestOmegaBound(PositionSystem::chain, k)) << sim::name(integrator);
+    const auto sheet = largestStableDt(PositionSystem::sheet, integrator, k, 1e-4, 0.1, 1.1, 400);
+    ASSERT_TRUE(sheet);
+    EXPECT_GT(*sheet, 0.95 * bound / highestOmegaBound(PositionSystem::sheet, k)) << sim::name(integrator);
+    EXPECT_LT(*sheet, 2.0 * bound / highestOmegaBound(PositionSystem::sheet, k)) << sim::name(integrator);
+  }
+  // Explicit Euler has no stable step: a step well inside the others' bound still blows up.
+  EXPECT_EQ(runForceModel(PositionSystem::chain, sim::Integrator::explicitEuler, 1000.0, 0.004, 400).verdict,
+            Stability::diverged);
+}
+
 }  // namespace
 }  // namespace drape::analysis

@@ -19,6 +19,8 @@ namespace {
 
 constexpr std::int64_t kSteps = 2000;
 constexpr double kDtMin = 1.0e-5, kDtMax = 0.1, kDtRatio = 1.2;
+constexpr std::int64_t kSystemSteps = 400;
+constexpr double kSystemDtRatio = 1.25;
 const sim::Integrator kIntegrators[] = {sim::Integrator::explicitEuler, sim::Integrator::symplecticEuler,
                                         sim::Integrator::verlet, sim::Integrator::midpoint, sim::Integrator::rk4};
 const double kStiffnesses[] = {1.0e1, 1.0e2, 1.0e3, 1.0e4, 1.0e5, 1.0e6, 1.0e7};
@@ -127,7 +129,50 @@ int stability(const StabilityArguments& arguments) {
            << " runs: " << counts[0] << " stable, " << counts[1] << " damped, " << counts[2]
            << " diverged (every run is in `stability/position.csv`). Unlike a stiff spring, a\n"
            << "projected constraint is not integrated as a force, so its stiffness puts no bound on the step.\n";
-    scene::writeFilesAtomically({{directory / "position.csv", positionMap.str()},
+    // The force model on the same chain and sheet: its springs put a bound on the step.
+    std::ostringstream systems;
+    systems << "system,integrator,stiffness,omega_max_bound,largest_stable_dt,theory_dt,ratio\n";
+    report << "\n## The force model on a chain and a sheet\n\n"
+           << "The same chain and sheet as springs of stiffness k (stretch, shear and, on the sheet, bend), undamped,\n"
+           << "under gravity, " << kSystemSteps << " steps, classified as above; dt from " << kDtMin << " s to "
+           << kDtMax << " s in steps of x" << kSystemDtRatio << ". Theory: the oscillator's bound over the system's\n"
+           << "highest angular frequency, bounded by Gershgorin's theorem on the stiffness matrix,\n"
+           << "omega_max <= sqrt(2 (sum of k at the busiest particle) / m): 2 sqrt(k / m) for the chain (exact for a\n"
+           << "long chain), sqrt(24 k / m) for the sheet (an overestimate, so its dt is a lower bound and the\n"
+           << "measured step may exceed it).\n\n"
+           << "| system | integrator | k (N/m) | omega_max bound (rad/s) | largest stable dt (s) | theory (s) | "
+              "measured / theory |\n|---|---|---|---|---|---|---|\n";
+    for (analysis::PositionSystem system : {analysis::PositionSystem::chain, analysis::PositionSystem::sheet}) {
+      for (sim::Integrator integrator :
+           {sim::Integrator::symplecticEuler, sim::Integrator::verlet, sim::Integrator::rk4,
+            sim::Integrator::explicitEuler, sim::Integrator::midpoint}) {
+        for (double k : {1.0e2, 1.0e3, 1.0e4, 1.0e5}) {
+          const double omega = analysis::highestOmegaBound(system, k);
+          const auto largest =
+              analysis::largestStableDt(system, integrator, k, kDtMin, kDtMax, kSystemDtRatio, kSystemSteps);
+          const auto bound = analysis::theoreticalStableOmegaDt(integrator);
+          const double theory = bound ? *bound / omega : NAN;
+          char line[320], measured[64], theoryText[64], ratioText[64];
+          const bool gridEnd = largest && *largest * kSystemDtRatio > kDtMax;
+          std::snprintf(measured, sizeof measured, largest ? (gridEnd ? ">= %.4g (end of scan)" : "%.4g") : "none",
+                        largest ? *largest : 0.0);
+          std::snprintf(theoryText, sizeof theoryText, bound ? "%.4g" : "never stable", theory);
+          std::snprintf(ratioText, sizeof ratioText, largest && bound && !gridEnd ? "%.2f" : "-",
+                        largest ? *largest / theory : 0.0);
+          std::snprintf(line, sizeof line, "| %s | %s | %.0e | %.4g | %s | %s | %s |\n",
+                        std::string(analysis::name(system)).c_str(), std::string(sim::name(integrator)).c_str(), k,
+                        omega, measured, theoryText, ratioText);
+          report << line;
+          systems << analysis::name(system) << ',' << sim::name(integrator) << ',' << k << ',' << omega << ','
+                  << (largest ? *largest : NAN) << ',' << theory << ',' << (largest && bound ? *largest / theory : NAN)
+                  << '\n';
+        }
+      }
+    }
+    report << "\nExplicit Euler and midpoint have no stable step undamped; the table shows the longest that survived\n"
+           << kSystemSteps << " steps.\n";
+    scene::writeFilesAtomically({{directory / "systems.csv", systems.str()},
+                                 {directory / "position.csv", positionMap.str()},
                                  {directory / "stability.csv", map.str()},
                                  {directory / "boundaries.csv", boundaries.str()},
                                  {directory / "stability.gp", plotScript(directory)}});
@@ -139,7 +184,7 @@ int stability(const StabilityArguments& arguments) {
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {
       std::printf("%s", report.str().c_str());
-      std::printf("wrote %s/stability.csv, boundaries.csv, stability.png%s%s\n", directory.c_str(),
+      std::printf("wrote %s/stability.csv, boundaries.csv, systems.csv, stability.png%s%s\n", directory.c_str(),
                   arguments.report ? " and " : "", arguments.report ? arguments.report->c_str() : "");
     }
     return kExitOk;

@@ -1,5 +1,6 @@
 #include "drape/analysis/stability.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "drape/sim/metrics.hpp"
@@ -54,24 +55,33 @@ OscillatorRun runOscillator(sim::Integrator integrator, double stiffness, double
 
 std::string_view name(PositionSystem system) { return system == PositionSystem::chain ? "chain" : "sheet"; }
 
-OscillatorRun runPositionModel(PositionSystem system, double stiffness, double dt, std::int64_t steps) {
+namespace {
+
+// The chain (21 particles, 1 m, pinned at one end, released horizontally) or the sheet (16 x 16,
+// 1 m, held by two corners, flat), 1 kg, every constraint kind at `material`.
+sim::WorldSettings system(PositionSystem which, sim::KindMaterial material) {
   sim::WorldSettings settings;
-  settings.solver.dt = dt;
-  settings.solver.iterations = 10;
   sim::ClothSettings cloth;
   cloth.mass = 1.0;
-  if (system == PositionSystem::chain) {
+  if (which == PositionSystem::chain) {
     cloth.lattice = {21, 1, 1.0, 1.0, sim::Vec3{0.0, 2.0, 0.0}, sim::LatticePlane::xy};
     cloth.pins = {{0, 0, std::nullopt}};
   } else {
     cloth.lattice = {16, 16, 1.0, 1.0, sim::Vec3{-0.5, 2.0, -0.5}, sim::LatticePlane::xz};
     cloth.pins = {{0, 0, std::nullopt}, {15, 0, std::nullopt}};
   }
-  for (sim::ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = {stiffness, 0.0};
-  if (system == PositionSystem::chain) cloth.material(sim::ConstraintKind::bend) = {0.0, 0.0};
+  for (sim::ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = material;
+  if (which == PositionSystem::chain) cloth.material(sim::ConstraintKind::bend) = {0.0, 0.0};
   settings.cloths.push_back(cloth);
+  return settings;
+}
+
+// The energy scale is the potential energy released by a 1 m drop, m g (1 m): diverged if the guard
+// trips or the mechanical energy ever rises more than 10 scales above its start; damped if the
+// kinetic energy at the end is below 1e-3 scales; stable otherwise.
+OscillatorRun classify(const sim::WorldSettings& settings, std::int64_t steps) {
   sim::World world(settings);
-  const double scale = cloth.mass * 9.81 * 1.0;
+  const double scale = 1.0 * 9.81 * 1.0;
   const double start = sim::energy(world).total();
   OscillatorRun run;
   run.maxEnergyRatio = run.endEnergyRatio = 0.0;  // here: (E - E0) / scale, and kinetic / scale at the end
@@ -91,6 +101,42 @@ OscillatorRun runPositionModel(PositionSystem system, double stiffness, double d
   }
   run.verdict = run.endEnergyRatio < 1e-3 ? Stability::damped : Stability::stable;
   return run;
+}
+
+}  // namespace
+
+OscillatorRun runPositionModel(PositionSystem which, double stiffness, double dt, std::int64_t steps) {
+  sim::WorldSettings settings = system(which, {stiffness, 0.0});
+  settings.solver.dt = dt;
+  settings.solver.iterations = 10;
+  return classify(settings, steps);
+}
+
+OscillatorRun runForceModel(PositionSystem which, sim::Integrator integrator, double stiffness, double dt,
+                            std::int64_t steps) {
+  sim::WorldSettings settings = system(which, {stiffness, 0.0});
+  settings.solver.model = sim::Model::force;
+  settings.solver.integrator = integrator;
+  settings.solver.dt = dt;
+  return classify(settings, steps);
+}
+
+double highestOmegaBound(PositionSystem which, double stiffness) {
+  // Springs at the busiest particle: the chain's 2 neighbours; the sheet's 4 structural, 4 shear
+  // and 4 bend neighbours.
+  const double particles = which == PositionSystem::chain ? 21.0 : 256.0;
+  const double springs = which == PositionSystem::chain ? 2.0 : 12.0;
+  return std::sqrt(2.0 * springs * stiffness / (1.0 / particles));
+}
+
+std::optional<double> largestStableDt(PositionSystem which, sim::Integrator integrator, double stiffness,
+                                      double dtMin, double dtMax, double ratio, std::int64_t steps) {
+  std::optional<double> largest;
+  for (double dt = dtMin; dt <= dtMax * (1.0 + 1e-12); dt *= ratio) {
+    if (runForceModel(which, integrator, stiffness, dt, steps).verdict == Stability::diverged) break;
+    largest = dt;
+  }
+  return largest;
 }
 
 std::optional<double> theoreticalStableOmegaDt(sim::Integrator integrator) {

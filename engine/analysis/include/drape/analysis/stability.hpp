@@ -47,6 +47,19 @@ enum class PositionSystem : std::uint8_t { chain, sheet };
 std::string_view name(PositionSystem system);
 OscillatorRun runPositionModel(PositionSystem system, double stiffness, double dt, std::int64_t steps);
 
+// The force model on the same chain and sheet: every spring (stretch, shear and, on the sheet, bend)
+// of stiffness k (N/m), undamped, under gravity, classified as runPositionModel classifies.
+OscillatorRun runForceModel(PositionSystem system, sim::Integrator integrator, double stiffness, double dt,
+                            std::int64_t steps);
+// A bound on the system's highest angular frequency (Gershgorin on the spring network's stiffness
+// matrix): omega_max^2 <= 2 (sum of the spring constants at the busiest particle) / its mass. The
+// chain's is exact for a long chain (2 sqrt(k / m)); the sheet's overestimates, so the step it
+// predicts is a lower bound.
+double highestOmegaBound(PositionSystem system, double stiffness);
+// As largestStableDt, for runForceModel.
+std::optional<double> largestStableDt(PositionSystem system, sim::Integrator integrator, double stiffness,
+                                      double dtMin, double dtMax, double ratio, std::int64_t steps);
+
 // The theoretical bound omega * dt below which the undamped oscillator is stable; none if never.
 std::optional<double> theoreticalStableOmegaDt(sim::Integrator integrator);
 
