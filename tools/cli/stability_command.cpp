@@ -25,6 +25,23 @@ const sim::Integrator kIntegrators[] = {sim::Integrator::explicitEuler, sim::Int
                                         sim::Integrator::verlet, sim::Integrator::midpoint, sim::Integrator::rk4};
 const double kStiffnesses[] = {1.0e1, 1.0e2, 1.0e3, 1.0e4, 1.0e5, 1.0e6, 1.0e7};
 
+// The report's cells for a largest stable step against theory.
+struct BoundCells {
+  char measured[64], theory[64], ratio[64];
+};
+
+BoundCells boundCells(std::optional<double> largest, bool hasBound, double theory, double dtRatio) {
+  BoundCells cells;
+  // The scan stops at kDtMax: there the bound was not reached, only passed without divergence.
+  const bool gridEnd = largest && *largest * dtRatio > kDtMax;
+  std::snprintf(cells.measured, sizeof cells.measured,
+                largest ? (gridEnd ? ">= %.4g (end of scan)" : "%.4g") : "none", largest ? *largest : 0.0);
+  std::snprintf(cells.theory, sizeof cells.theory, hasBound ? "%.4g" : "never stable", theory);
+  std::snprintf(cells.ratio, sizeof cells.ratio, largest && hasBound && !gridEnd ? "%.2f" : "-",
+                largest ? *largest / theory : 0.0);
+  return cells;
+}
+
 std::string plotScript(const std::filesystem::path& directory) {
   std::ostringstream gp;
   gp << "set terminal pngcairo size 1500,360 font ',10'\n"
@@ -92,17 +109,11 @@ int stability(const StabilityArguments& arguments) {
         }
         const auto largest = analysis::largestStableDt(integrator, k, kDtMin, kDtMax, kDtRatio, kSteps);
         const auto bound = analysis::theoreticalStableOmegaDt(integrator);
-        char line[256], measured[64], theoryText[64], ratioText[64];
         const double theory = bound ? *bound / omega : NAN;
-        // The scan stops at kDtMax: there the bound was not reached, only passed without divergence.
-        const bool gridEnd = largest && *largest * kDtRatio > kDtMax;
-        std::snprintf(measured, sizeof measured, largest ? (gridEnd ? ">= %.4g (end of scan)" : "%.4g") : "none",
-                      largest ? *largest : 0.0);
-        std::snprintf(theoryText, sizeof theoryText, bound ? "%.4g" : "never stable", theory);
-        std::snprintf(ratioText, sizeof ratioText, largest && bound && !gridEnd ? "%.2f" : "-",
-                      largest ? *largest / theory : 0.0);
-        std::snprintf(line, sizeof line, "| %s | %.0e | %.3g | %s | %s | %s |\n", name.c_str(), k, omega, measured,
-                      theoryText, ratioText);
+        const BoundCells cells = boundCells(largest, bound.has_value(), theory, kDtRatio);
+        char line[256];
+        std::snprintf(line, sizeof line, "| %s | %.0e | %.3g | %s | %s | %s |\n", name.c_str(), k, omega,
+                      cells.measured, cells.theory, cells.ratio);
         report << line;
         boundaries << name << ',' << k << ',' << omega << ',' << (largest ? *largest : NAN) << ',' << theory << ','
                    << (largest && bound ? *largest / theory : NAN) << '\n';
@@ -152,16 +163,11 @@ int stability(const StabilityArguments& arguments) {
               analysis::largestStableDt(system, integrator, k, kDtMin, kDtMax, kSystemDtRatio, kSystemSteps);
           const auto bound = analysis::theoreticalStableOmegaDt(integrator);
           const double theory = bound ? *bound / omega : NAN;
-          char line[320], measured[64], theoryText[64], ratioText[64];
-          const bool gridEnd = largest && *largest * kSystemDtRatio > kDtMax;
-          std::snprintf(measured, sizeof measured, largest ? (gridEnd ? ">= %.4g (end of scan)" : "%.4g") : "none",
-                        largest ? *largest : 0.0);
-          std::snprintf(theoryText, sizeof theoryText, bound ? "%.4g" : "never stable", theory);
-          std::snprintf(ratioText, sizeof ratioText, largest && bound && !gridEnd ? "%.2f" : "-",
-                        largest ? *largest / theory : 0.0);
+          const BoundCells cells = boundCells(largest, bound.has_value(), theory, kSystemDtRatio);
+          char line[320];
           std::snprintf(line, sizeof line, "| %s | %s | %.0e | %.4g | %s | %s | %s |\n",
                         std::string(analysis::name(system)).c_str(), std::string(sim::name(integrator)).c_str(), k,
-                        omega, measured, theoryText, ratioText);
+                        omega, cells.measured, cells.theory, cells.ratio);
           report << line;
           systems << analysis::name(system) << ',' << sim::name(integrator) << ',' << k << ',' << omega << ','
                   << (largest ? *largest : NAN) << ',' << theory << ',' << (largest && bound ? *largest / theory : NAN)
