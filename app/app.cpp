@@ -3,15 +3,15 @@
 #include <SDL.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
-#include <imgui.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <backends/imgui_impl_sdl.h>
+#include <imgui.h>
 #include <nlohmann/json.hpp>
 
 #include "drape/interact/replay.hpp"
@@ -174,7 +174,7 @@ std::optional<InputEvent> translate(const SDL_Event& e, const WindowSize& size) 
     case SDL_FINGERDOWN:
     case SDL_FINGERMOTION:
     case SDL_FINGERUP:
-      event.kind = e.type == SDL_FINGERDOWN   ? InputEvent::Kind::touchDown
+      event.kind = e.type == SDL_FINGERDOWN ? InputEvent::Kind::touchDown
                    : e.type == SDL_FINGERUP ? InputEvent::Kind::touchUp
                                             : InputEvent::Kind::touchMove;
       event.touch = e.tfinger.touchId;
@@ -242,8 +242,8 @@ std::string screenshotName() {
 // Reads back the window (scene and panels) and writes it as PNG. Returns a message for the HUD.
 std::string screenshot(const render::Renderer& renderer, const WindowSize& size, const std::string& file) {
   try {
-    scene::writeFileAtomically(file, cli::encodePng(renderer.readPixels(size.pixelsWide, size.pixelsHigh),
-                                                    size.pixelsWide, size.pixelsHigh));
+    scene::writeFileAtomically(
+        file, cli::encodePng(renderer.readPixels(size.pixelsWide, size.pixelsHigh), size.pixelsWide, size.pixelsHigh));
     return "screenshot: " + file;
   } catch (const scene::InputError& error) {
     return error.what();
@@ -270,7 +270,8 @@ int runApp(const AppOptions& options) {
   const auto set = [](const char* name) { return std::getenv(name) && *std::getenv(name); };
   if (!set("DISPLAY") && !set("WAYLAND_DISPLAY") && !set("SDL_VIDEODRIVER")) {
     // Asking SDL would probe every driver (and libraries print their complaints): say it once.
-    std::cerr << "drape: no display: set DISPLAY (X11) or WAYLAND_DISPLAY (drape-cli render draws scenes without one)\n";
+    std::cerr
+        << "drape: no display: set DISPLAY (X11) or WAYLAND_DISPLAY (drape-cli render draws scenes without one)\n";
     return kExitNoDisplay;
   }
   if (SDL_Init(SDL_INIT_VIDEO | SDL_INIT_TIMER) != 0) {
@@ -280,7 +281,8 @@ int runApp(const AppOptions& options) {
   // With no display SDL falls back to drivers that draw nowhere: that is no display, unless asked for.
   const std::string driver = SDL_GetCurrentVideoDriver() ? SDL_GetCurrentVideoDriver() : "";
   if ((driver == "offscreen" || driver == "dummy") && !std::getenv("SDL_VIDEODRIVER")) {
-    std::cerr << "drape: no display: set DISPLAY (X11) or WAYLAND_DISPLAY (drape-cli render draws scenes without one)\n";
+    std::cerr
+        << "drape: no display: set DISPLAY (X11) or WAYLAND_DISPLAY (drape-cli render draws scenes without one)\n";
     SDL_Quit();
     return kExitNoDisplay;
   }
@@ -421,7 +423,7 @@ int runApp(const AppOptions& options) {
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
         if (toLoad) session->load(*toLoad);  // on failure the message is in the status line and the scene stays
-        remap();  // a load, reset or model change made a new interaction
+        remap();                             // a load, reset or model change made a new interaction
         if (options.screenshotAfter && frame + 1 == *options.screenshotAfter && options.screenshotFile) {
           const std::string said = screenshot(*renderer, size, *options.screenshotFile);
           if (said.rfind("screenshot: ", 0) != 0) {
@@ -449,9 +451,10 @@ int runApp(const AppOptions& options) {
 
     if (options.out) {
       try {
-        scene::writeFileAtomically(*options.out, scene::stateDocument(session->scene(), session->world())
-                                                         .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
-                                                     "\n");
+        scene::writeFileAtomically(*options.out,
+                                   scene::stateDocument(session->scene(), session->world())
+                                           .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                                       "\n");
       } catch (const scene::InputError& error) {
         std::cerr << "drape: error: " << error.what() << "\n";
         exitCode = 2;

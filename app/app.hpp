@@ -13,13 +13,13 @@ namespace drape::app {
 inline constexpr int kExitNoDisplay = 4;
 
 struct AppOptions {
-  std::string scene = "hang";                 // a scene (path or shipped name) or a snapshot (*.drape.json)
-  std::optional<std::string> replay;          // gesture script, pushed through SDL as touch events
-  std::optional<std::string> record;          // write what the fingers did here at exit
+  std::string scene = "hang";                   // a scene (path or shipped name) or a snapshot (*.drape.json)
+  std::optional<std::string> replay;            // gesture script, pushed through SDL as touch events
+  std::optional<std::string> record;            // write what the fingers did here at exit
   std::optional<std::int64_t> screenshotAfter;  // frames
   std::optional<std::string> screenshotFile;
-  std::optional<std::int64_t> exitAfter;      // frames
-  std::optional<std::string> out;             // final state (JSON) at exit, as drape-cli run --out
+  std::optional<std::int64_t> exitAfter;  // frames
+  std::optional<std::string> out;         // final state (JSON) at exit, as drape-cli run --out
   int width = 1280;
   int height = 800;
 };

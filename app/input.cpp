@@ -82,7 +82,8 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
         const auto nearest = std::min_element(parked_.begin(), parked_.end(), [&](const Parked& a, const Parked& b) {
           return std::hypot(a.x - event.x, a.y - event.y) < std::hypot(b.x - event.x, b.y - event.y);
         });
-        if (nearest != parked_.end() && std::hypot(nearest->x - event.x, nearest->y - event.y) <= options_.parkedReach) {
+        if (nearest != parked_.end() &&
+            std::hypot(nearest->x - event.x, nearest->y - event.y) <= options_.parkedReach) {
           interaction_.up(nearest->id);
           parked_.erase(nearest);
         }

@@ -31,14 +31,14 @@ struct InputEvent {
   int button = 0;           // 1 left, 2 middle, 3 right
   bool shift = false;
   bool ctrl = false;
-  double wheel = 0.0;       // notches, positive away from the user
+  double wheel = 0.0;  // notches, positive away from the user
 };
 
 struct InputOptions {
-  double wheelLift = 0.02;      // m per wheel notch
-  double orbitSpeed = 4.0;      // rad per window width dragged
-  double zoomPerNotch = 1.1;    // distance divided by this per notch towards the scene
-  double parkedReach = 0.05;    // a Ctrl-click lifts a parked finger this close (window widths)
+  double wheelLift = 0.02;    // m per wheel notch
+  double orbitSpeed = 4.0;    // rad per window width dragged
+  double zoomPerNotch = 1.1;  // distance divided by this per notch towards the scene
+  double parkedReach = 0.05;  // a Ctrl-click lifts a parked finger this close (window widths)
 };
 
 class InputMapper {

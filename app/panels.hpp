@@ -14,7 +14,21 @@
 namespace drape::app {
 
 enum class KeyAction : std::uint8_t {
-  none, pause, step, reset, undo, screenshot, sticky, cut, create, plane, help, panels, save, load, quit
+  none,
+  pause,
+  step,
+  reset,
+  undo,
+  screenshot,
+  sticky,
+  cut,
+  create,
+  plane,
+  help,
+  panels,
+  save,
+  load,
+  quit
 };
 
 // A fixed-length history for the plots.

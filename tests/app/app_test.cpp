@@ -12,8 +12,8 @@
 #include <sstream>
 #include <string>
 
-#include <nlohmann/json.hpp>
 #include <stb/stb_image.h>
+#include <nlohmann/json.hpp>
 
 namespace {
 
@@ -36,7 +36,8 @@ class App : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    directory_ = fs::temp_directory_path() / ("drape-app-test-" + std::string(test->name()) + "-" + std::to_string(::getpid()));
+    directory_ =
+        fs::temp_directory_path() / ("drape-app-test-" + std::string(test->name()) + "-" + std::to_string(::getpid()));
     fs::remove_all(directory_);
     fs::create_directories(directory_);
   }
@@ -184,15 +185,15 @@ TEST_F(App, RecordingWritesAScriptThatReplays) {
   EXPECT_GT(moves, 10);
   EXPECT_EQ(ups, 1);
   // drape-cli reads it back.
-  const std::string replay = std::string("'") + DRAPE_CLI + "' replay desk '" + file("recorded.json").string() + "' --quiet";
+  const std::string replay =
+      std::string("'") + DRAPE_CLI + "' replay desk '" + file("recorded.json").string() + "' --quiet";
   EXPECT_EQ(std::system(replay.c_str()), 0);
 }
 
 TEST_F(App, WithoutADisplayItSaysSoInOneLine) {
   // (--exit-after only so that a failure of this test cannot hang the run.)
   const std::string command = "env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER ASAN_OPTIONS=detect_leaks=0 '" +
-                              std::string(DRAPE_APP) +
-                              "' desk --exit-after 30 2>'" + file("err.txt").string() + "'";
+                              std::string(DRAPE_APP) + "' desk --exit-after 30 2>'" + file("err.txt").string() + "'";
   const int status = std::system(command.c_str());
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 4);

@@ -1,9 +1,9 @@
 // The app's input layer and session as functions of events: no window, no GL.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <fstream>
-#include <unistd.h>
 #include <limits>
 
 #include <glm/geometric.hpp>
@@ -228,7 +228,10 @@ TEST(Session, SaveAndLoadBringBackATornClothExactly) {
   for (int i = 0; i < 10; ++i) ASSERT_EQ(loaded.step(), sim::StepStatus::ok);
   // A snapshot that is not one is refused, and the session stays.
   const std::filesystem::path bad = std::filesystem::temp_directory_path() / "drape-bad.drape.json";
-  { std::ofstream(bad) << R"({"drapeSnapshot": 1, "scene": {}, "cloths": [{"restPositions": [[0, 0, 0]], "triangles": [[0, 1, 2]]}]})"; }
+  {
+    std::ofstream(bad)
+        << R"({"drapeSnapshot": 1, "scene": {}, "cloths": [{"restPositions": [[0, 0, 0]], "triangles": [[0, 1, 2]]}]})";
+  }
   const std::optional<std::string> error = loaded.load(bad);
   std::filesystem::remove(bad);
   ASSERT_TRUE(error);
@@ -282,7 +285,7 @@ TEST(Session, AnotherModelRestartsTheSceneWithThatModelsMaterials) {
   EXPECT_EQ(settings.solver.model, sim::Model::force);
   EXPECT_EQ(settings.solver.integrator, sim::Integrator::rk4);
   EXPECT_EQ(settings.cloths[0].material(sim::ConstraintKind::stretch).stiffness, 2000.0);  // N/m now
-  EXPECT_FALSE(session.world().hasStage(sim::Stage::selfCollide));  // the force model has none
+  EXPECT_FALSE(session.world().hasStage(sim::Stage::selfCollide));                         // the force model has none
   EXPECT_EQ(session.step(), sim::StepStatus::ok);
   ASSERT_FALSE(session.setModel(sim::Model::position, sim::Integrator::rk4));
   EXPECT_EQ(session.world().settings().solver.integrator, sim::Integrator::verlet);

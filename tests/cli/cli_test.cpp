@@ -248,14 +248,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"OutlineTooBig",
                  R"({"cloths": [{"outline": {"points": [[0, 0], [100, 0], [100, 100], [0, 100]], "spacing": 0.01}}]})",
                  "", "bad.json: cloths.0.outline: "},
-        BadInput{"OutlineAndGrid", R"({"cloths": [{"grid": {}, "outline": {"points": [[0, 0], [1, 0], [0, 1]]}}]})",
-                 "", "bad.json: cloths.0.grid: expected either \"grid\" or \"outline\""},
+        BadInput{"OutlineAndGrid", R"({"cloths": [{"grid": {}, "outline": {"points": [[0, 0], [1, 0], [0, 1]]}}]})", "",
+                 "bad.json: cloths.0.grid: expected either \"grid\" or \"outline\""},
         BadInput{"OutlinePointNotAPair", R"({"cloths": [{"outline": {"points": [[0, 0], [1, 0], [0, 1, 2]]}}]})", "",
                  "bad.json: cloths.0.outline.points.2: expected [x, z]"},
         BadInput{"TearingAtRestLength", R"({"tearing": {"threshold": 1}})", "",
                  "bad.json: tearing.threshold: expected a number > 1"},
-        BadInput{"NestedTooDeep", deeplyNested(), "",
-                 "bad.json: nested more than 64 levels deep"}),
+        BadInput{"NestedTooDeep", deeplyNested(), "", "bad.json: nested more than 64 levels deep"}),
     [](const auto& testInfo) { return std::string(testInfo.param.name); });
 
 TEST_F(Cli, RenderWritesAPngOfTheRequestedSize) {
@@ -433,9 +432,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadGesture{"TwoPointers",
                    R"({"events": [{"time": 0, "type": "down", "finger": 1, "at": [0, 0, 0], "screen": [0, 0]}]})",
                    "g.json: events.0.screen: expected exactly one of"},
-        BadGesture{"ScreenWithoutCamera", R"({"events": [{"time": 0, "type": "down", "finger": 1, "screen": [0.5, 0.5]}]})",
+        BadGesture{"ScreenWithoutCamera",
+                   R"({"events": [{"time": 0, "type": "down", "finger": 1, "screen": [0.5, 0.5]}]})",
                    "g.json: events.0.screen: expected a \"camera\""},
-        BadGesture{"ScreenNotAPair", R"({"camera": {}, "events": [{"time": 0, "type": "move", "finger": 1, "screen": [0.5]}]})",
+        BadGesture{"ScreenNotAPair",
+                   R"({"camera": {}, "events": [{"time": 0, "type": "move", "finger": 1, "screen": [0.5]}]})",
                    "g.json: events.0.screen: expected [x, y]"},
         BadGesture{"ZeroRadius", R"({"finger": {"radius": 0}})", "g.json: finger.radius: expected a number > 0"},
         BadGesture{"BadPlane", R"({"finger": {"plane": "wall"}})", "g.json: finger.plane: expected one of"},
@@ -448,5 +449,6 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& testInfo) { return std::string(testInfo.param.name); });
 
 TEST_F(Cli, AMissingGestureFileIsBadInput) {
-  expectOneLineError(run("replay hang " + file("nowhere.json").string()), 2, "nowhere.json: cannot open the gesture script");
+  expectOneLineError(run("replay hang " + file("nowhere.json").string()), 2,
+                     "nowhere.json: cannot open the gesture script");
 }

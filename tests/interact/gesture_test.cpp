@@ -81,7 +81,8 @@ Real footprint(const sim::Cloth& cloth) {
 Real spread(const sim::Cloth& cloth) {
   const Vec3 middle = centroid(cloth);
   Real sum = 0.0;
-  for (const Vec3& x : cloth.state.position) sum += (x.x - middle.x) * (x.x - middle.x) + (x.z - middle.z) * (x.z - middle.z);
+  for (const Vec3& x : cloth.state.position)
+    sum += (x.x - middle.x) * (x.x - middle.x) + (x.z - middle.z) * (x.z - middle.z);
   return std::sqrt(sum / static_cast<Real>(cloth.state.position.size()));
 }
 
@@ -158,8 +159,8 @@ TEST(Gesture, CrumpleGathersTheClothIntoAPile) {
   const Real before = spread(played.cloth());
   played.until();
   EXPECT_LT(spread(played.cloth()), 0.75 * before) << spread(played.cloth()) << " from " << before;
-  EXPECT_GT(highest(played.cloth()), 0.03);   // folds rise out of the table
-  EXPECT_GT(lowest(played.cloth()), 0.0);     // none under it
+  EXPECT_GT(highest(played.cloth()), 0.03);  // folds rise out of the table
+  EXPECT_GT(lowest(played.cloth()), 0.0);    // none under it
 }
 
 TEST(Gesture, SpreadFlattensACrumpledCloth) {
@@ -191,9 +192,9 @@ TEST(Gesture, FoldLaysTheNearHalfOnTopOfTheFarHalf) {
       }
     }
   }
-  EXPECT_LT(nearEdgeZ, -0.15);  // the near edge went over to the far side
+  EXPECT_LT(nearEdgeZ, -0.15);                          // the near edge went over to the far side
   EXPECT_GT(nearHalfY / near, farHalfY / far + 0.008);  // and lies on top
-  EXPECT_LT(highest(cloth), 0.08);  // flat, in two layers
+  EXPECT_LT(highest(cloth), 0.08);                      // flat, in two layers
 }
 
 TEST(Gesture, LiftRaisesTheClothOffTheTable) {
@@ -212,12 +213,12 @@ TEST(Gesture, DrapeLaysTheClothOverTheBall) {
   const Vec3 ball{0.5, 0.15, 0.0};
   Real closest = 1e9;
   for (const Vec3& x : cloth.state.position) closest = std::min(closest, glm::length(x - ball));
-  EXPECT_GT(closest, 0.15 - 1e-3);                 // nothing inside the ball
+  EXPECT_GT(closest, 0.15 - 1e-3);  // nothing inside the ball
   // Resting on its top: above it, at most a couple of layers (the self-collision distance, 2 cm) thick.
   EXPECT_GT(highest(cloth), 0.3);
   EXPECT_LT(highest(cloth), 0.3 + 0.005 + 2 * 0.02 + 0.005);
-  EXPECT_NEAR(centroid(cloth).x, 0.5, 0.1);        // centred over it
-  EXPECT_LT(lowest(cloth), 0.01);                  // and down to the table around it
+  EXPECT_NEAR(centroid(cloth).x, 0.5, 0.1);  // centred over it
+  EXPECT_LT(lowest(cloth), 0.01);            // and down to the table around it
 }
 
 TEST(Gesture, PinHoldsTheCornerUpUntilItIsTakenOut) {
@@ -353,13 +354,14 @@ TEST(ExtremeGesture, AFingerJumping100MetresInOneFrame) {
     }
     sim::World world(scene.world);
     const double dt = scene.world.solver.dt;
-    const nlohmann::json document = {{"events", {
-        {{"time", 0.2}, {"type", "down"}, {"finger", 1}, {"at", {0.0, 0.005, 0.0}}},
-        {{"time", 0.5}, {"type", "move"}, {"finger", 1}, {"at", {0.0, 0.005, 0.0}}},
-        {{"time", 0.5 + dt}, {"type", "move"}, {"finger", 1}, {"at", {100.0, 0.005, 0.0}}},
-        {{"time", 1.5}, {"type", "move"}, {"finger", 1}, {"at", {100.0, 0.005, 0.0}}},
-        {{"time", 1.5 + dt}, {"type", "move"}, {"finger", 1}, {"at", {0.0, 0.005, 0.0}}},
-        {{"time", 1.7}, {"type", "up"}, {"finger", 1}}}}};
+    const nlohmann::json document = {
+        {"events",
+         {{{"time", 0.2}, {"type", "down"}, {"finger", 1}, {"at", {0.0, 0.005, 0.0}}},
+          {{"time", 0.5}, {"type", "move"}, {"finger", 1}, {"at", {0.0, 0.005, 0.0}}},
+          {{"time", 0.5 + dt}, {"type", "move"}, {"finger", 1}, {"at", {100.0, 0.005, 0.0}}},
+          {{"time", 1.5}, {"type", "move"}, {"finger", 1}, {"at", {100.0, 0.005, 0.0}}},
+          {{"time", 1.5 + dt}, {"type", "move"}, {"finger", 1}, {"at", {0.0, 0.005, 0.0}}},
+          {{"time", 1.7}, {"type", "up"}, {"finger", 1}}}}};
     const interact::GestureScript script = scene::parseGesture(document, "jump.json");
     interact::Interaction interaction(world);
     interact::Replay replay(world, interaction, script);

@@ -243,8 +243,9 @@ namespace drape::scene {
 namespace {
 
 // assets/extreme: stiff, huge steps, many iterations, hurricane, one particle, coincident particles,
-// heavy gravity, a mass ratio of 1e6 between neighbours, every constraint torn. The position model must stay finite and bounded in every one; the force model may
-// diverge, but then the world must say so (at which step) and hold the last good, finite state.
+// heavy gravity, a mass ratio of 1e6 between neighbours, every constraint torn. The position model must stay finite and
+// bounded in every one; the force model may diverge, but then the world must say so (at which step) and hold the last
+// good, finite state.
 TEST(ExtremeScenes, PositionModelStaysFiniteAndBoundedForceModelReportsDivergence) {
   int count = 0;
   for (const auto& entry : std::filesystem::directory_iterator(sceneDirectory().parent_path() / "extreme")) {

@@ -27,7 +27,8 @@ WorldSettings flatSheet(int n, Vec3 gravity = Vec3{0.0}) {
 
 Real totalMass(const World& world) {
   Real mass = 0.0;
-  for (const Cloth& cloth : world.cloths()) mass = std::accumulate(cloth.state.mass.begin(), cloth.state.mass.end(), mass);
+  for (const Cloth& cloth : world.cloths())
+    mass = std::accumulate(cloth.state.mass.begin(), cloth.state.mass.end(), mass);
   return mass;
 }
 
@@ -125,7 +126,7 @@ TEST(Finger, AParticleUnderTwoFingersBelongsToTheFirst) {
   std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(both));
   EXPECT_TRUE(both.empty());
   EXPECT_EQ(world.pressFinger(1, Vec3{0.0}, 0.1), -1);  // already down
-  EXPECT_FALSE(world.moveFinger(3, Vec3{0.0}));          // never down
+  EXPECT_FALSE(world.moveFinger(3, Vec3{0.0}));         // never down
   EXPECT_FALSE(world.releaseFinger(3));
 }
 
@@ -260,8 +261,10 @@ TEST(Cutting, ASwipeAcrossTheSheetMakesTwoPiecesThatMoveApart) {
   Real farHighest = -1.0, nearLowest = 1.0;
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
     const Vec3 x = cloth.state.position[i];
-    if (cloth.piece[i] == cloth.piece[cloth.rest.index(0, 0)]) farHighest = std::max(farHighest, x.y);
-    else nearLowest = std::min(nearLowest, x.y);
+    if (cloth.piece[i] == cloth.piece[cloth.rest.index(0, 0)])
+      farHighest = std::max(farHighest, x.y);
+    else
+      nearLowest = std::min(nearLowest, x.y);
   }
   EXPECT_LT(farHighest, 1e-9);
   EXPECT_GT(nearLowest, 0.1);

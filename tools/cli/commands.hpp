@@ -37,12 +37,12 @@ struct RenderArguments {
   SceneArguments input;
   std::optional<std::int64_t> steps;
   std::optional<double> seconds;
-  std::string size = "800x600";       // WxH pixels
-  std::string camera = "auto";        // a preset or yaw,pitch,distance[,x,y,z]
-  std::optional<std::string> out;     // one picture of the last step
-  std::optional<std::int64_t> every;  // a picture every K steps ...
-  std::optional<std::string> outDir;  // ... into this folder
-  bool strain = false;                // strain colour map
+  std::string size = "800x600";        // WxH pixels
+  std::string camera = "auto";         // a preset or yaw,pitch,distance[,x,y,z]
+  std::optional<std::string> out;      // one picture of the last step
+  std::optional<std::int64_t> every;   // a picture every K steps ...
+  std::optional<std::string> outDir;   // ... into this folder
+  bool strain = false;                 // strain colour map
   std::optional<std::string> gesture;  // a gesture script played while running
   bool quiet = false;
 };

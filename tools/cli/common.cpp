@@ -33,9 +33,12 @@ std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> st
   if (!(wanted <= kMaxSteps)) {
     char count[64];
     std::snprintf(count, sizeof count, "%.0f", wanted);
-    throw scene::InputError(scene.source + ": " + (seconds ? "--time" : script ? "the gesture's length" : "duration") +
-                            " / solver.dt asks for " + count +
-                            " steps, more than the limit of " + std::to_string(static_cast<long long>(kMaxSteps)));
+    throw scene::InputError(scene.source + ": " +
+                            (seconds  ? "--time"
+                             : script ? "the gesture's length"
+                                      : "duration") +
+                            " / solver.dt asks for " + count + " steps, more than the limit of " +
+                            std::to_string(static_cast<long long>(kMaxSteps)));
   }
   return static_cast<std::int64_t>(wanted);
 }

@@ -34,8 +34,8 @@ BoundCells boundCells(std::optional<double> largest, bool hasBound, double theor
   BoundCells cells;
   // The scan stops at kDtMax: there the bound was not reached, only passed without divergence.
   const bool gridEnd = largest && *largest * dtRatio > kDtMax;
-  std::snprintf(cells.measured, sizeof cells.measured,
-                largest ? (gridEnd ? ">= %.4g (end of scan)" : "%.4g") : "none", largest ? *largest : 0.0);
+  std::snprintf(cells.measured, sizeof cells.measured, largest ? (gridEnd ? ">= %.4g (end of scan)" : "%.4g") : "none",
+                largest ? *largest : 0.0);
   std::snprintf(cells.theory, sizeof cells.theory, hasBound ? "%.4g" : "never stable", theory);
   std::snprintf(cells.ratio, sizeof cells.ratio, largest && hasBound && !gridEnd ? "%.2f" : "-",
                 largest ? *largest / theory : 0.0);

@@ -129,8 +129,8 @@ double highestOmegaBound(PositionSystem which, double stiffness) {
   return std::sqrt(2.0 * springs * stiffness / (1.0 / particles));
 }
 
-std::optional<double> largestStableDt(PositionSystem which, sim::Integrator integrator, double stiffness,
-                                      double dtMin, double dtMax, double ratio, std::int64_t steps) {
+std::optional<double> largestStableDt(PositionSystem which, sim::Integrator integrator, double stiffness, double dtMin,
+                                      double dtMax, double ratio, std::int64_t steps) {
   std::optional<double> largest;
   for (double dt = dtMin; dt <= dtMax * (1.0 + 1e-12); dt *= ratio) {
     if (runForceModel(which, integrator, stiffness, dt, steps).verdict == Stability::diverged) break;

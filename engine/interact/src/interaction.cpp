@@ -129,7 +129,8 @@ bool Interaction::down(int id, const Pointer& pointer, std::optional<Real> radiu
     std::optional<Vec3> pressed;
     if (pointer.kind == Pointer::Kind::world) {
       if (!finite(pointer.world)) return fail("finger " + std::to_string(id) + ": the point is not finite");
-      if (world_.pressFinger(id, pointer.world, r) < 0) return fail("finger " + std::to_string(id) + " is already down");
+      if (world_.pressFinger(id, pointer.world, r) < 0)
+        return fail("finger " + std::to_string(id) + " is already down");
       pressed = pointer.world;
     } else {
       if (!std::isfinite(pointer.screen.x) || !std::isfinite(pointer.screen.y)) {
@@ -179,10 +180,10 @@ bool Interaction::move(int id, const Pointer& pointer) {
     case Mode::sticky: break;  // the target follows in update()
     case Mode::cut:
       if (glm::length(*point - previous) > 0.0) {
-        const Vec3 depth = pointer.kind == Pointer::Kind::screen
-                               ? glm::normalize(camera_.ray(pointer.screen.x, pointer.screen.y, aspect_).direction +
-                                                touch->depth)
-                               : touch->depth;
+        const Vec3 depth =
+            pointer.kind == Pointer::Kind::screen
+                ? glm::normalize(camera_.ray(pointer.screen.x, pointer.screen.y, aspect_).direction + touch->depth)
+                : touch->depth;
         if (!touch->cutStarted && beforeCut) beforeCut();
         touch->cutStarted = true;
         if (world_.cut(previous, *point, depth) > 0) touch->cutSomething = true;

@@ -11,9 +11,9 @@ namespace drape::scene {
 
 namespace {
 
-using nlohmann::json;
 using interact::GestureEvent;
 using interact::Pointer;
+using nlohmann::json;
 
 constexpr std::size_t kMaxEvents = 1000000;
 constexpr double kMaxCoordinate = 1.0e4;  // m
@@ -159,7 +159,8 @@ json gestureDocument(const interact::GestureScript& script) {
                         {"pinchDistance", s.pinchDistance},
                         {"pinchHeight", s.pinchHeight},
                         {"liftSpeed", s.liftSpeed}};
-  document["draw"] = {{"spacing", s.spacing}, {"table", s.tableHeight}, {"height", s.clothHeight}, {"density", s.arealDensity}};
+  document["draw"] = {
+      {"spacing", s.spacing}, {"table", s.tableHeight}, {"height", s.clothHeight}, {"density", s.arealDensity}};
   json events = json::array();
   for (const GestureEvent& e : script.events) {
     json event = {{"time", e.time}, {"type", std::string(interact::name(e.type))}};

@@ -107,7 +107,8 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
   sim::ClothSettings cloth;
   if (reader.has("outline")) {
     if (reader.has("grid")) reader.fail("grid", "either \"grid\" or \"outline\", not both", reader.raw("grid"));
-    if (reader.has("pins")) reader.fail("pins", "no pins on a drawn cloth (they name lattice columns and rows)", reader.raw("pins"));
+    if (reader.has("pins"))
+      reader.fail("pins", "no pins on a drawn cloth (they name lattice columns and rows)", reader.raw("pins"));
     ObjectReader outlineReader = reader.object("outline");
     sim::OutlineSpec outline = readOutline(outlineReader);
     try {
@@ -325,7 +326,8 @@ sim::ClothSettings drawnClothTemplate(const Scene& scene) {
     return cloth;
   }
   sim::ClothSettings cloth;
-  for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(scene.world.solver.model, kind);
+  for (ConstraintKind kind : sim::kConstraintKinds)
+    cloth.material(kind) = defaultMaterial(scene.world.solver.model, kind);
   return cloth;
 }
 

@@ -117,14 +117,15 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
                                                 return glm::uvec3{*a, *b, *d};
                                               });
     for (sim::ConstraintKind kind : sim::kConstraintKinds) {
-      cloth.rest.constraints[static_cast<std::size_t>(kind)] = tuples<sim::DistanceConstraint>(
-          reader, sim::name(kind), 3, "[a, b, rest length], " + particle,
-          [&](const json& k) -> std::optional<sim::DistanceConstraint> {
-            const auto a = index(k[0]), b = index(k[1]);
-            const double rest = k[2].get<double>();
-            if (!a || !b || *a == *b || !std::isfinite(rest) || rest < 0.0) return std::nullopt;
-            return sim::DistanceConstraint{*a, *b, rest};
-          });
+      cloth.rest.constraints[static_cast<std::size_t>(kind)] =
+          tuples<sim::DistanceConstraint>(reader, sim::name(kind), 3, "[a, b, rest length], " + particle,
+                                          [&](const json& k) -> std::optional<sim::DistanceConstraint> {
+                                            const auto a = index(k[0]), b = index(k[1]);
+                                            const double rest = k[2].get<double>();
+                                            if (!a || !b || *a == *b || !std::isfinite(rest) || rest < 0.0)
+                                              return std::nullopt;
+                                            return sim::DistanceConstraint{*a, *b, rest};
+                                          });
     }
     sim::ParticleState& s = cloth.state;
     s.position = tuples<sim::Vec3>(reader, "positions", 3, "[x, y, z], finite", vec3);

@@ -173,7 +173,8 @@ void sever(Topology& topology, std::uint32_t t, int edge) {
 }
 
 // Gives every fan of triangles around each touched particle but the first a particle of its own.
-void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_t budget, std::vector<ParticleSplit>& splits) {
+void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_t budget,
+                    std::vector<ParticleSplit>& splits) {
   ClothRest& rest = cloth.rest;
   ParticleState& s = cloth.state;
   const Topology& topology = cloth.topology;
@@ -273,8 +274,9 @@ void build(Cloth& cloth) {
       uses.push_back({lo << 32 | hi, t, k});
     }
   }
-  std::sort(uses.begin(), uses.end(),
-            [](const EdgeUse& l, const EdgeUse& r) { return std::tie(l.key, l.triangle) < std::tie(r.key, r.triangle); });
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& l, const EdgeUse& r) {
+    return std::tie(l.key, l.triangle) < std::tie(r.key, r.triangle);
+  });
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     while (j < uses.size() && uses[j].key == uses[i].key) ++j;
@@ -311,8 +313,9 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
   if (strained.empty()) return false;
   build(cloth);
   // The most strained first: they decide where the crack runs.
-  std::sort(strained.begin(), strained.end(),
-            [](const auto& l, const auto& r) { return l.first > r.first || (l.first == r.first && l.second < r.second); });
+  std::sort(strained.begin(), strained.end(), [](const auto& l, const auto& r) {
+    return l.first > r.first || (l.first == r.first && l.second < r.second);
+  });
   Topology& topology = cloth.topology;
   const ClothRest& rest = cloth.rest;
   const Incidence incidence(rest.triangles, rest.particleCount());

@@ -57,8 +57,8 @@ OscillatorRun runForceModel(PositionSystem system, sim::Integrator integrator, d
 // predicts is a lower bound.
 double highestOmegaBound(PositionSystem system, double stiffness);
 // As largestStableDt, for runForceModel.
-std::optional<double> largestStableDt(PositionSystem system, sim::Integrator integrator, double stiffness,
-                                      double dtMin, double dtMax, double ratio, std::int64_t steps);
+std::optional<double> largestStableDt(PositionSystem system, sim::Integrator integrator, double stiffness, double dtMin,
+                                      double dtMax, double ratio, std::int64_t steps);
 
 // The theoretical bound omega * dt below which the undamped oscillator is stable; none if never.
 std::optional<double> theoreticalStableOmegaDt(sim::Integrator integrator);

@@ -42,25 +42,25 @@ std::optional<FingerPlane> parsePlane(std::string_view text);
 struct Pointer {
   enum class Kind : std::uint8_t { world, screen };
   Kind kind = Kind::world;
-  Vec3 world{0.0};          // m
-  glm::dvec2 screen{0.0};   // the picture's x, y in 0..1 from the top left (may lie outside)
+  Vec3 world{0.0};         // m
+  glm::dvec2 screen{0.0};  // the picture's x, y in 0..1 from the top left (may lie outside)
 
   static Pointer at(Vec3 point) { return {Kind::world, point, {}}; }
   static Pointer onScreen(double x, double y) { return {Kind::screen, Vec3{0.0}, {x, y}}; }
 };
 
 struct InteractionSettings {
-  Real radius = 0.05;             // m, of a sticky finger
+  Real radius = 0.05;  // m, of a sticky finger
   FingerPlane plane = FingerPlane::table;
-  Real pinchDistance = 0.1;       // m: two holding fingers closer than this pinch-lift
-  Real pinchHeight = 0.2;         // m, how far a pinch lifts
-  Real liftSpeed = 1.0;           // m/s, how fast a finger rises or sinks to a new height (pinch, lift)
+  Real pinchDistance = 0.1;  // m: two holding fingers closer than this pinch-lift
+  Real pinchHeight = 0.2;    // m, how far a pinch lifts
+  Real liftSpeed = 1.0;      // m/s, how fast a finger rises or sinks to a new height (pinch, lift)
   // Drawn cloths:
-  Real spacing = 0.04;            // m, between particles
-  Real tableHeight = 0.0;         // m, the table's y (outlines are drawn on it)
-  Real clothHeight = 0.01;        // m, above the table where a drawn cloth appears
-  Real arealDensity = 0.2;        // kg/m^2
-  sim::ClothSettings material;    // materials and thickness of drawn cloths
+  Real spacing = 0.04;          // m, between particles
+  Real tableHeight = 0.0;       // m, the table's y (outlines are drawn on it)
+  Real clothHeight = 0.01;      // m, above the table where a drawn cloth appears
+  Real arealDensity = 0.2;      // kg/m^2
+  sim::ClothSettings material;  // materials and thickness of drawn cloths
 };
 
 // One event of a finger's life, as gesture scripts hold them and the app records them.
@@ -69,10 +69,10 @@ struct GestureEvent {
   double time = 0.0;  // s
   Type type = Type::move;
   int finger = 0;
-  std::optional<Pointer> pointer;  // down, move, unpin
-  std::optional<Real> radius;      // down (m), unpin (m)
-  Real height = 0.0;               // lift (m)
-  Mode mode = Mode::sticky;        // mode
+  std::optional<Pointer> pointer;          // down, move, unpin
+  std::optional<Real> radius;              // down (m), unpin (m)
+  Real height = 0.0;                       // lift (m)
+  Mode mode = Mode::sticky;                // mode
   FingerPlane plane = FingerPlane::table;  // plane
 };
 
@@ -132,16 +132,16 @@ class Interaction {
   struct Touch {
     int id = 0;
     Mode mode = Mode::sticky;
-    Vec3 anchor{0.0};             // a point of the finger's plane
-    Vec3 normal{0.0, 1.0, 0.0};   // the plane's normal
-    Vec3 onPlane{0.0};            // where the pointer is, in the plane (or in the world)
-    Real height = 0.0;            // m, lifted by the user ...
-    Real heightGoal = 0.0;        // ... on its way here at liftSpeed
-    Real pinch = 0.0;             // m, lifted by a pinch
+    Vec3 anchor{0.0};            // a point of the finger's plane
+    Vec3 normal{0.0, 1.0, 0.0};  // the plane's normal
+    Vec3 onPlane{0.0};           // where the pointer is, in the plane (or in the world)
+    Real height = 0.0;           // m, lifted by the user ...
+    Real heightGoal = 0.0;       // ... on its way here at liftSpeed
+    Real pinch = 0.0;            // m, lifted by a pinch
     bool holds = false;
     std::vector<Vec3> stroke;
-    Vec3 depth{0.0, -1.0, 0.0};   // cut: the direction the cut surface extends along
-    bool cutStarted = false;  // beforeCut was called for this stroke
+    Vec3 depth{0.0, -1.0, 0.0};  // cut: the direction the cut surface extends along
+    bool cutStarted = false;     // beforeCut was called for this stroke
     bool cutSomething = false;
   };
 

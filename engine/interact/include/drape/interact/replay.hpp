@@ -31,7 +31,7 @@ struct GestureScript {
 struct ReplayAction {
   std::size_t index = 0;  // the script's event (for a move on the way: the finger's last keyframe)
   bool onTheWay = false;
-  Pointer pointer;        // on the way: where the finger is at the end of the step
+  Pointer pointer;  // on the way: where the finger is at the end of the step
 };
 
 // The timeline of a script without its effects: what is due when. The replay below applies the

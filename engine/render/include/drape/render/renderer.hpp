@@ -50,9 +50,9 @@ struct FrameOptions {
   bool strainMap = false;     // colour by stretch instead of the front/back colours
   float strainScale = 0.10f;  // strain shown fully red
   bool showPins = true;
-  bool multisample = true;    // 4x MSAA when the context has it
-  int shadowSoftness = 3;     // 0..3: shadow filter taps (2s+1)^2 on the table; a software renderer pays for each
-  int shadowMapSize = 2048;   // texels a side, 256..4096
+  bool multisample = true;   // 4x MSAA when the context has it
+  int shadowSoftness = 3;    // 0..3: shadow filter taps (2s+1)^2 on the table; a software renderer pays for each
+  int shadowMapSize = 2048;  // texels a side, 256..4096
   glm::vec3 frontColour{0.85f, 0.33f, 0.18f};
   glm::vec3 backColour{0.20f, 0.52f, 0.62f};
   glm::vec3 backgroundColour{0.62f, 0.66f, 0.70f};

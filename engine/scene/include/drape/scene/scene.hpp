@@ -23,7 +23,7 @@ struct Scene {
   std::string description;  // one line for humans
   double duration = 5.0;    // s, how long a run lasts when the caller does not say
   sim::WorldSettings world;
-  std::string document;     // the JSON it was read from, overrides applied (snapshots keep it)
+  std::string document;  // the JSON it was read from, overrides applied (snapshots keep it)
 };
 
 // Reads, overrides and validates a scene file. Throws InputError.

@@ -34,8 +34,8 @@ struct ConstraintTemplate {
   std::uint32_t t1 = 0, t2 = 0;
   ConstraintKind kind = ConstraintKind::stretch;
   Link link = Link::same;
-  std::uint8_t corner1 = 0, corner2 = 0;   // of a in t1, of b in t2
-  std::uint8_t middle1 = 0, middle2 = 0;   // through: corners of the middle particle; across: edge1 = middle1
+  std::uint8_t corner1 = 0, corner2 = 0;  // of a in t1, of b in t2
+  std::uint8_t middle1 = 0, middle2 = 0;  // through: corners of the middle particle; across: edge1 = middle1
   bool broken = false;
 };
 

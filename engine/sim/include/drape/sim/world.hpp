@@ -22,7 +22,7 @@ struct Cloth {
   ClothRest rest;
   ParticleState state;
   ClothSettings settings;
-  Topology topology;                // built the first time the cloth tears or is cut
+  Topology topology;                 // built the first time the cloth tears or is cut
   std::vector<std::uint32_t> piece;  // per particle: which connected piece it belongs to
   std::uint32_t pieceCount = 1;
 };
@@ -36,10 +36,10 @@ struct FingerGrip {
 };
 
 struct Finger {
-  int id = 0;            // the caller's name for it
-  Vec3 position{0.0};    // m, where it is now
-  Vec3 target{0.0};      // m, where the next step takes it (along a straight line)
-  Real radius = 0.0;     // m
+  int id = 0;          // the caller's name for it
+  Vec3 position{0.0};  // m, where it is now
+  Vec3 target{0.0};    // m, where the next step takes it (along a straight line)
+  Real radius = 0.0;   // m
   std::vector<FingerGrip> grips;
 };
 
