@@ -22,6 +22,12 @@ void addLengthOptions(CLI::App* command, std::optional<std::int64_t>& steps, std
       ->excludes(stepsOption);
 }
 
+// --out and --quiet of run and replay.
+void addRunOutputs(CLI::App* command, RunArguments& arguments) {
+  command->add_option("--out", arguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
+  command->add_flag("--quiet", arguments.quiet, "Print nothing on success");
+}
+
 // --out-dir, --report and --quiet of the studies.
 void addReportOptions(CLI::App* command, std::string& outDir, std::optional<std::string>& report, bool& quiet) {
   command->add_option("--out-dir", outDir, "Folder for CSV and picture (default " + outDir + ")");
@@ -43,7 +49,7 @@ int main(int argc, char** argv) {
   CLI::App* runCommand = app.add_subcommand("run", "Simulate a scene and write its final state, mesh or a trace");
   addSceneOptions(runCommand, runArguments.input);
   addLengthOptions(runCommand, runArguments.steps, runArguments.seconds);
-  runCommand->add_option("--out", runArguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
+  addRunOutputs(runCommand, runArguments);
   CLI::Option* trace = runCommand->add_option("--trace", runArguments.trace, "Trace one particle: column,row");
   runCommand->add_option("--trace-cloth", runArguments.traceCloth, "Which cloth --trace refers to (default 0)")
       ->check(CLI::Range(0, 1000))
@@ -53,7 +59,6 @@ int main(int argc, char** argv) {
   trace->needs(traceOut);
   traceOut->needs(trace);
   runCommand->add_option("--gesture", runArguments.gesture, "Play this gesture script while running");
-  runCommand->add_flag("--quiet", runArguments.quiet, "Print nothing on success");
 
   RunArguments replayArguments;
   CLI::App* replayCommand = app.add_subcommand(
@@ -61,8 +66,7 @@ int main(int argc, char** argv) {
   addSceneOptions(replayCommand, replayArguments.input);
   replayCommand->add_option("gesture", replayArguments.gesture, "Gesture script (JSON)")->required();
   addLengthOptions(replayCommand, replayArguments.steps, replayArguments.seconds);
-  replayCommand->add_option("--out", replayArguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
-  replayCommand->add_flag("--quiet", replayArguments.quiet, "Print nothing on success");
+  addRunOutputs(replayCommand, replayArguments);
 
   RenderArguments renderArguments;
   CLI::App* renderCommand =

@@ -140,7 +140,8 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
     std::vector<Real> area(n, 0.0);
     Real total = 0.0;
     for (const glm::uvec3& t : cloth.rest.triangles) {
-      const Real a = 0.5 * glm::length(glm::cross(s.position[t[1]] - s.position[t[0]], s.position[t[2]] - s.position[t[0]]));
+      const Real a =
+          0.5 * glm::length(glm::cross(s.position[t[1]] - s.position[t[0]], s.position[t[2]] - s.position[t[0]]));
       for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
       total += a;
     }
@@ -287,7 +288,6 @@ Vec3 World::velocity(int cloth, ParticleIndex particle) const {
 void World::startHistory(std::size_t c) {
   const Real h = static_cast<Real>(substepDt());
   if (settings_.solver.model == Model::position) {
-    if (hasStage(Stage::windPressure)) scratch_[c].acceleration.assign(cloths_[c].state.position.size(), Vec3{0.0});
     position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity,
                            settings_.solver.damping + settings_.air.drag, h);
   } else {
@@ -423,7 +423,6 @@ StepStatus World::run(std::int64_t steps) {
   }
   return StepStatus::ok;
 }
-
 
 // ---- fingers ----------------------------------------------------------------------------------
 
@@ -605,7 +604,8 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   grow(scratch.sumVelocity, n);
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
   // A tether may not reach across a tear.
-  std::erase_if(scratch.tethers, [&](const SolverScratch::Tether& t) { return cloth.piece[t.particle] != cloth.piece[t.pin]; });
+  std::erase_if(scratch.tethers,
+                [&](const SolverScratch::Tether& t) { return cloth.piece[t.particle] != cloth.piece[t.pin]; });
   topologyVersion_ = nextTopologyVersion();
 }
 
@@ -613,7 +613,8 @@ void World::tear() {
   std::vector<ParticleSplit> splits;
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     splits.clear();
-    const std::size_t budget = static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
+    const std::size_t budget =
+        static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
     if (!topology::tear(cloths_[c], settings_.tearing.threshold, budget, splits)) continue;
     afterTopologyChange(c, splits);
   }
@@ -625,7 +626,8 @@ int World::cut(Vec3 a, Vec3 b, Vec3 depth) {
   std::vector<ParticleSplit> splits;
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     splits.clear();
-    const std::size_t budget = static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
+    const std::size_t budget =
+        static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
     if (!topology::cut(cloths_[c], a, b, depth, budget, splits)) continue;
     afterTopologyChange(c, splits);
     ++opened;
@@ -644,9 +646,11 @@ void World::setTearing(const TearSettings& tearing) {
 void World::tune(const WorldSettings& next) {
   WorldSettings candidate = next;
   candidate.cloths = settings_.cloths;
-  require(candidate.solver.model == settings_.solver.model && candidate.solver.integrator == settings_.solver.integrator,
-          "the model and the integrator cannot change while the world runs");
-  require(candidate.colliders.size() == settings_.colliders.size(), "colliders cannot be added or removed while the world runs");
+  require(
+      candidate.solver.model == settings_.solver.model && candidate.solver.integrator == settings_.solver.integrator,
+      "the model and the integrator cannot change while the world runs");
+  require(candidate.colliders.size() == settings_.colliders.size(),
+          "colliders cannot be added or removed while the world runs");
   for (std::size_t i = 0; i < candidate.colliders.size(); ++i) {
     // Only the friction of a collider is tunable: everything else stays as it is.
     const Friction friction = candidate.colliders[i].friction;
@@ -717,7 +721,8 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
       require(finite(cloth.rest.restPositions[i]) && finite(s.position[i]) && finite(s.previousPosition[i]) &&
                   (s.velocity.empty() || finite(s.velocity[i])),
               "a cloth has a position that is not finite");
-      require(finite(s.mass[i]) && s.mass[i] > 0.0 && std::isfinite(1.0 / s.mass[i]), "a particle's mass must be positive");
+      require(finite(s.mass[i]) && s.mass[i] > 0.0 && std::isfinite(1.0 / s.mass[i]),
+              "a particle's mass must be positive");
     }
     for (const glm::uvec3& t : cloth.rest.triangles) {
       require(t.x < n && t.y < n && t.z < n, "a triangle names a particle the cloth does not have");
@@ -752,7 +757,8 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
     cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
     held_.emplace_back(s.position.size(), 0);
     buildTethers(c);
-    if (settings_.solver.model == Model::force) force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), scratch_[c]);
+    if (settings_.solver.model == Model::force)
+      force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), scratch_[c]);
   }
   buildPipeline();
   // The cloths come with their own history (x_prev, velocities): the next step must not restart it.
