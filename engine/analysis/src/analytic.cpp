@@ -36,11 +36,12 @@ double freeFallError(int substeps) {
   return worst;
 }
 
-double catenaryError(int links, int iterations, double* strain) {
+double catenaryError(int links, int iterations, double* strain, bool lines) {
   const double length = 1.2, span = 1.0, top = 1.0;
   sim::WorldSettings settings;
   settings.solver.substeps = 4;
   settings.solver.iterations = iterations;
+  settings.solver.lines = lines;
   settings.air.drag = 2.0;
   sim::ClothSettings c = chain(links, length, 0.5, sim::Vec3{-length / 2, top, 0.0});
   c.pins = {{0, 0, sim::Vec3{-span / 2, top, 0.0}}, {links, 0, sim::Vec3{span / 2, top, 0.0}}};

@@ -202,10 +202,13 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.damping = solver.number("damping", 0.0, {0.0, 1000.0, false, "1/s"});
     world.solver.xpbd = solver.boolean("xpbd", false);
     world.solver.tethers = solver.boolean("tethers", false);
-    if ((world.solver.xpbd || world.solver.tethers) && world.solver.model != Model::position) {
-      solver.fail(world.solver.xpbd ? "xpbd" : "tethers",
-                  "false for the force model (it belongs to the position model)",
-                  solver.raw(world.solver.xpbd ? "xpbd" : "tethers"));
+    world.solver.lines = solver.boolean("lines", false);
+    if (world.solver.model != Model::position) {
+      for (const char* key : {"xpbd", "tethers", "lines"}) {
+        if (solver.has(key) && solver.boolean(key, false)) {
+          solver.fail(key, "false for the force model (it belongs to the position model)", solver.raw(key));
+        }
+      }
     }
     solver.finish();
   }
@@ -292,7 +295,7 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
     for (sim::ClothSettings& cloth : changed.world.cloths) {
       for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(model, kind);
     }
-    if (model == Model::force) solver.xpbd = solver.tethers = false;
+    if (model == Model::force) solver.xpbd = solver.tethers = solver.lines = false;
   }
   solver.model = model;
   solver.integrator = integrator;
@@ -305,6 +308,7 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
     if (model == Model::force) {
       solverDocument.erase("xpbd");
       solverDocument.erase("tethers");
+      solverDocument.erase("lines");
     }
     if (document.contains("cloths") && document["cloths"].is_array()) {
       for (json& cloth : document["cloths"]) {

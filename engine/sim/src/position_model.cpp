@@ -2,7 +2,9 @@
 
 #include "aerodynamics.hpp"
 #include "contacts.hpp"
+#include "lines.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -37,7 +39,8 @@ void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, 
       [&](ParticleIndex p) { return (s.position[p] - s.previousPosition[p]) * inverseH; }, acceleration);
 }
 
-void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration) {
+void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
+               Workers& workers) {
   ParticleState& s = cloth.state;
   // Exact for du/dt = a - k u over one substep: u' = u e^{-kh} + a h (1 - e^{-kh}) / (k h).
   const Real kh = (world.solver.damping + world.air.drag) * h;
@@ -45,21 +48,26 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
   const Real relaxed = relaxation(kh);
   const Vec3 constantAcceleration = world.gravity + world.air.drag * world.air.velocity;
   const Real h2 = h * h * relaxed;
-  for (std::size_t i = 0; i < s.position.size(); ++i) {
-    if (s.inverseMass[i] == 0.0) {
-      // Pinned or held: no force moves it, only the world does. It carries on as it was set to move
-      // (a finger sets x_prev one finger step behind); a pin has x_prev = x and stays exactly put.
-      const Vec3 x = s.position[i];
-      s.position[i] = x + (x - s.previousPosition[i]);
-      s.previousPosition[i] = x;
-      continue;
-    }
-    Vec3 acceleration = constantAcceleration;
-    if (extraAcceleration) acceleration += (*extraAcceleration)[i];
-    const Vec3 x = s.position[i];
-    s.position[i] = x + (x - s.previousPosition[i]) * decay + acceleration * h2;
-    s.previousPosition[i] = x;
-  }
+  workers.run(
+      s.position.size(),
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t i = begin; i < end; ++i) {
+          if (s.inverseMass[i] == 0.0) {
+            // Pinned or held: no force moves it, only the world does. It carries on as it was set to move
+            // (a finger sets x_prev one finger step behind); a pin has x_prev = x and stays exactly put.
+            const Vec3 x = s.position[i];
+            s.position[i] = x + (x - s.previousPosition[i]);
+            s.previousPosition[i] = x;
+            continue;
+          }
+          Vec3 acceleration = constantAcceleration;
+          if (extraAcceleration) acceleration += (*extraAcceleration)[i];
+          const Vec3 x = s.position[i];
+          s.position[i] = x + (x - s.previousPosition[i]) * decay + acceleration * h2;
+          s.previousPosition[i] = x;
+        }
+      },
+      4096);
 }
 
 void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inverseMass, const DistanceConstraint& c,
@@ -98,42 +106,197 @@ void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inve
   position[c.b] += n * (wb * deltaLambda);
 }
 
-void projectTethers(ParticleState& s, const std::vector<SolverScratch::Tether>& tethers) {
-  for (const SolverScratch::Tether& t : tethers) {
-    // The anchor was let go, or a finger holds the particle (then the finger decides where it is).
-    if (s.inverseMass[t.pin] != 0.0 || s.inverseMass[t.particle] == 0.0) continue;
-    const Vec3 d = s.position[t.particle] - s.position[t.pin];
-    const Real length = glm::length(d);
-    if (length > t.length) s.position[t.particle] = s.position[t.pin] + d * (t.length / length);
+bool tetherActive(const ParticleState& s, const SolverScratch::Tether& t) {
+  // The anchor was let go, or a finger holds the particle (then the finger decides where it is).
+  return s.inverseMass[t.pin] == 0.0 && s.inverseMass[t.particle] != 0.0;
+}
+
+// Onto the ball of radius r around c, if outside it.
+Vec3 intoBall(Vec3 x, Vec3 c, Real r) {
+  const Vec3 d = x - c;
+  const Real length2 = glm::dot(d, d);
+  if (length2 <= r * r) return x;
+  return c + d * (r / std::sqrt(length2));
+}
+
+bool inBall(Vec3 x, Vec3 c, Real r) {
+  const Vec3 d = x - c;
+  return glm::dot(d, d) <= r * r * (1.0 + 1e-12);
+}
+
+// The nearest point to x within both balls (Euclidean projection onto their intersection, which
+// is never empty for tethers: the rest shape lies in it). Projecting onto one ball and then the
+// other instead converges slowly where the balls barely overlap, as they do along an edge between
+// two pins (the radii add up to the pins' distance): that edge then sags.
+Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb) {
+  const Vec3 toA = intoBall(x, a, ra);
+  if (inBall(toA, b, rb)) return toA;
+  const Vec3 toB = intoBall(x, b, rb);
+  if (inBall(toB, a, ra)) return toB;
+  // On both spheres: the circle where they meet, centre a + n t, radius rho, in the plane normal to n.
+  const Vec3 axis = b - a;
+  const Real distance = glm::length(axis);
+  if (!(distance > 0.0)) return toA;
+  const Vec3 n = axis / distance;
+  const Real t = std::clamp((distance * distance + ra * ra - rb * rb) / (2.0 * distance), 0.0, ra);
+  const Real rho = std::sqrt(std::max(ra * ra - t * t, 0.0));
+  const Vec3 centre = a + n * t;
+  const Vec3 off = (x - centre) - n * glm::dot(x - centre, n);
+  const Real offLength = glm::length(off);
+  // On the axis every point of the circle is as near; any is as good as another.
+  if (!(offLength > 1e-15 * (rho + distance))) return centre;
+  return centre + off * (rho / offLength);
+}
+
+// The tethers [begin, end), widened or narrowed to whole particles (a particle's tethers are
+// consecutive and projected together).
+void projectTethers(ParticleState& s, const std::vector<SolverScratch::Tether>& tethers, std::size_t begin,
+                    std::size_t end) {
+  const auto sameParticle = [&](std::size_t k) { return tethers[k].particle == tethers[k - 1].particle; };
+  while (begin > 0 && begin < tethers.size() && sameParticle(begin)) ++begin;
+  while (end > 0 && end < tethers.size() && sameParticle(end)) ++end;
+  for (std::size_t k = begin; k < end;) {
+    const ParticleIndex particle = tethers[k].particle;
+    std::size_t last = k + 1;
+    while (last < tethers.size() && tethers[last].particle == particle) ++last;
+    if (last - k == 2 && tetherActive(s, tethers[k]) && tetherActive(s, tethers[k + 1])) {
+      s.position[particle] = intoLens(s.position[particle], s.position[tethers[k].pin], tethers[k].length,
+                                      s.position[tethers[k + 1].pin], tethers[k + 1].length);
+    } else {
+      for (std::size_t j = k; j < last; ++j) {
+        const SolverScratch::Tether& t = tethers[j];
+        if (tetherActive(s, t)) s.position[particle] = intoBall(s.position[particle], s.position[t.pin], t.length);
+      }
+    }
+    k = last;
+  }
+}
+
+// Constraints [begin, end) of one kind, as projectDistance each. A batch's constraints share no
+// particle, so they are taken four at a time: gathered into lanes, their square roots and divisions
+// done side by side (the compiler turns the lane loops into vector instructions), and scattered
+// back. Every constraint's arithmetic is exactly projectDistance's.
+void projectRange(ParticleState& s, const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
+                  Real stiffness) {
+  constexpr std::size_t L = 4;
+  Vec3* x = s.position.data();
+  const Real* w = s.inverseMass.data();
+  std::size_t k = begin;
+  for (; k + L <= end; k += L) {
+    Real dx[L], dy[L], dz[L], wa[L], wb[L], rest[L], length2[L], length[L], factor[L];
+    for (std::size_t g = 0; g < L; ++g) {
+      const DistanceConstraint& c = constraints[k + g];
+      const Vec3 d = x[c.b] - x[c.a];
+      dx[g] = d.x;
+      dy[g] = d.y;
+      dz[g] = d.z;
+      wa[g] = w[c.a];
+      wb[g] = w[c.b];
+      rest[g] = c.restLength;
+    }
+    for (std::size_t g = 0; g < L; ++g) length2[g] = dx[g] * dx[g] + dy[g] * dy[g] + dz[g] * dz[g];
+    for (std::size_t g = 0; g < L; ++g) length[g] = std::sqrt(length2[g] > 1e-20 ? length2[g] : 1.0);
+    for (std::size_t g = 0; g < L; ++g) {
+      const Real wSum = wa[g] + wb[g];
+      factor[g] = stiffness * (length[g] - rest[g]) / (length[g] * (wSum > 0.0 ? wSum : 1.0));
+    }
+    for (std::size_t g = 0; g < L; ++g) {
+      // Coincident particles, or two that nothing moves: left alone, as projectDistance does.
+      if (wa[g] + wb[g] == 0.0 || !(length2[g] > 1e-20)) continue;
+      const DistanceConstraint& c = constraints[k + g];
+      const Vec3 correction = Vec3{dx[g], dy[g], dz[g]} * factor[g];
+      x[c.a] += wa[g] * correction;
+      x[c.b] -= wb[g] * correction;
+    }
+  }
+  for (; k < end; ++k) projectDistance(s.position, s.inverseMass, constraints[k], stiffness);
+}
+
+void projectCompliantRange(ParticleState& s, const DistanceConstraint* constraints, Real* lambda, std::size_t begin,
+                           std::size_t end, Real alphaTilde) {
+  for (std::size_t k = begin; k < end; ++k)
+    projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
+}
+
+}  // namespace
+
+namespace {
+
+// The seed's sweep: every kind in order (stretch, shear, bend), each constraint after the one
+// before it in the order the cloth lists them, then the tethers. One thread.
+void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch) {
+  ParticleState& s = cloth.state;
+  for (ConstraintKind kind : kConstraintKinds) {
+    const KindMaterial& material = cloth.settings.material(kind);
+    if (material.stiffness == 0.0) continue;
+    const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
+    if (solver.xpbd) {
+      projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
+                            constraints.size(), material.compliance / (h * h));
+    } else {
+      for (const DistanceConstraint& c : constraints) projectDistance(s.position, s.inverseMass, c, material.stiffness);
+    }
+  }
+  if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers, 0, scratch.tethers.size());
+}
+
+// The fast sweep (solver.lines): tethers first, then bend and shear in batches shared among the
+// workers, then the stretch constraints a line at a time, last, so that a sweep ends with what
+// matters most to the eye, the cloth's length.
+void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, Workers& workers) {
+  ParticleState& s = cloth.state;
+  if (!scratch.tethers.empty()) {
+    workers.run(scratch.tethers.size(),
+                [&](std::size_t begin, std::size_t end, int) { projectTethers(s, scratch.tethers, begin, end); });
+  }
+  for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
+    const std::size_t kindIndex = static_cast<std::size_t>(kind);
+    const KindMaterial& material = cloth.settings.material(kind);
+    if (material.stiffness == 0.0) continue;
+    const Real alphaTilde = material.compliance / (h * h);
+    if (kind == ConstraintKind::stretch) {
+      lines::solve(cloth, scratch, solver.xpbd ? 1.0 : material.stiffness, solver.xpbd, alphaTilde, workers);
+      continue;
+    }
+    const DistanceConstraint* constraints = cloth.rest.of(kind).data();
+    Real* lambda = scratch.lambda[kindIndex].data();
+    const auto body = [&](std::size_t begin, std::size_t end) {
+      if (solver.xpbd) {
+        projectCompliantRange(s, constraints, lambda, begin, end, alphaTilde);
+      } else {
+        projectRange(s, constraints, begin, end, material.stiffness);
+      }
+    };
+    const std::vector<std::uint32_t>& start = scratch.batchStart[kindIndex];
+    for (std::size_t b = 0; b + 1 < start.size(); ++b) {
+      const std::size_t begin = start[b], end = start[b + 1];
+      if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
+        body(begin, end);
+      } else {
+        workers.run(end - begin, [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last); });
+      }
+    }
   }
 }
 
 }  // namespace
 
-void projectConstraints(Cloth& cloth, int iterations, Real h, bool xpbd, SolverScratch& scratch, bool contacts) {
-  ParticleState& s = cloth.state;
-  if (xpbd) {
+void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, bool contacts,
+                        Workers& workers) {
+  if (solver.xpbd) {
     for (ConstraintKind kind : kConstraintKinds) {
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
     }
-  }
-  for (int iteration = 0; iteration < iterations; ++iteration) {
-    for (ConstraintKind kind : kConstraintKinds) {
-      const KindMaterial& material = cloth.settings.material(kind);
-      if (material.stiffness == 0.0) continue;
-      const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
-      if (xpbd) {
-        const Real alphaTilde = material.compliance / (h * h);
-        std::vector<Real>& lambda = scratch.lambda[static_cast<std::size_t>(kind)];
-        for (std::size_t k = 0; k < constraints.size(); ++k) {
-          projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
-        }
-      } else {
-        for (const DistanceConstraint& c : constraints)
-          projectDistance(s.position, s.inverseMass, c, material.stiffness);
-      }
+    if (solver.lines) {
+      for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.rest.size(), 0.0);
     }
-    if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers);
+  }
+  for (int iteration = 0; iteration < solver.iterations; ++iteration) {
+    if (solver.lines) {
+      sweepInBatches(cloth, solver, h, scratch, workers);
+    } else {
+      sweepInOrder(cloth, solver, h, scratch);
+    }
     if (contacts) contact::project(cloth, scratch);
   }
 }

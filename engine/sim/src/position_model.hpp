@@ -6,6 +6,7 @@
 
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
+#include "workers.hpp"
 
 namespace drape::sim::position {
 
@@ -25,18 +26,23 @@ void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, 
 // solution of du/dt = a - k u over the substep, so no damping or drag can make it overshoot and a
 // falling particle reaches exactly the terminal velocity a / k. Pinned particles (inverse mass 0)
 // do not move.
-void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration);
+void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
+               Workers& workers);
 
-// `iterations` Gauss-Seidel sweeps over the stretch, shear and bend constraints. Each violated
+// `solver.iterations` Gauss-Seidel sweeps over the stretch, shear and bend constraints, in the
+// batches of scratch (batches.hpp; built for the cloth's current constraints). Each violated
 // constraint is corrected as the seed writes it, weighted by inverse mass and scaled by the kind's
 // stiffness k:  dx_a = k w_a / (w_a + w_b) (|x_b - x_a| - r) (x_b - x_a) / |x_b - x_a|,
 //               dx_b = -k w_b / (w_a + w_b) (...)
 // With equal masses and k = 1 that is exactly the seed's dx_1 = 1/2 (|x2 - x1| - r)(x2 - x1)/|x2 - x1|.
-// With `contacts`, the contact planes are re-enforced after every sweep, so the constraints cannot
-// pull a particle back into a collider.
-// With `xpbd`, each kind resists with its compliance instead (see settings.hpp); with tethers in
-// `scratch`, they are enforced after every sweep too.
-void projectConstraints(Cloth& cloth, int iterations, Real h, bool xpbd, SolverScratch& scratch, bool contacts);
+// Each sweep starts with the tethers (scratch.tethers), if any. With `contacts`, the contact
+// planes are re-enforced after every sweep, so the constraints cannot pull a particle back into a
+// collider. With solver.xpbd each kind resists with its compliance instead (see settings.hpp); with
+// solver.lines the stretch constraints are solved a line at a time (lines.hpp; scratch.lines
+// built). Batches, lines and tethers are shared among the workers: the result does not depend on
+// how many there are.
+void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, bool contacts,
+                        Workers& workers);
 
 // Removes the kind's damping fraction of the relative velocity along each constraint, by moving
 // x_prev, conserving momentum.

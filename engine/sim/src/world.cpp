@@ -9,10 +9,13 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "batches.hpp"
 #include "contacts.hpp"
 #include "force_model.hpp"
+#include "lines.hpp"
 #include "position_model.hpp"
 #include "topology.hpp"
+#include "workers.hpp"
 
 namespace drape::sim {
 
@@ -181,7 +184,8 @@ std::uint64_t nextTopologyVersion() {
   return ++counter;
 }
 
-World::World(WorldSettings settings) : settings_(std::move(settings)), topologyVersion_(nextTopologyVersion()) {
+World::World(WorldSettings settings)
+    : settings_(std::move(settings)), topologyVersion_(nextTopologyVersion()), workers_(std::make_unique<Workers>(1)) {
   validate(settings_);
   for (const ClothSettings& clothSettings : settings_.cloths) {
     cloths_.push_back(makeCloth(clothSettings, settings_.solver.model));
@@ -200,10 +204,15 @@ World::World(WorldSettings settings) : settings_(std::move(settings)), topologyV
 void World::buildTethers(std::size_t c) {
   if (!settings_.solver.tethers || settings_.solver.model != Model::position) return;
   const Cloth& cloth = cloths_[c];
+  std::vector<std::size_t> pins;
   for (std::size_t p = 0; p < cloth.state.position.size(); ++p) {
-    if (!cloth.state.pinned[p]) continue;
-    for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-      if (cloth.state.inverseMass[i] == 0.0 || cloth.piece[i] != cloth.piece[p]) continue;
+    if (cloth.state.pinned[p]) pins.push_back(p);
+  }
+  // Particle by particle, so that a particle's tethers are consecutive and projected together.
+  for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+    if (cloth.state.inverseMass[i] == 0.0) continue;
+    for (const std::size_t p : pins) {
+      if (cloth.piece[i] != cloth.piece[p]) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
       const Real length = glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]);
       scratch_[c].tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
@@ -272,6 +281,87 @@ void World::buildPipeline() {
   }
 }
 
+void World::plan(std::size_t c) {
+  SolverScratch& scratch = scratch_[c];
+  if (scratch.planVersion == topologyVersion_) return;
+  if (settings_.solver.lines) {
+    // The fast sweep's batches: the constraints are put in batch order, once per topology.
+    const batches::Batches made = batches::colour(cloths_[c].rest);
+    scratch.batchStart = made.start;
+    scratch.sequentialTail = made.sequentialTail;
+    lines::build(cloths_[c], scratch, workers_->threads());
+  } else {
+    scratch.batchStart = {};
+    scratch.lines = {};
+    scratch.looseStretch.clear();
+    scratch.lineNormal.clear();
+    scratch.lineUpper.clear();
+    scratch.lineSolution.clear();
+  }
+  scratch.planVersion = topologyVersion_;
+}
+
+void World::setThreads(int threads) {
+  require(threads >= 1 && threads <= kMaxThreads, "threads must be 1 to 64");
+  if (threads == workers_->threads()) return;
+  workers_ = std::make_unique<Workers>(threads);
+  for (SolverScratch& scratch : scratch_) scratch.planVersion = 0;  // line slices are per thread
+}
+
+int World::threads() const { return workers_->threads(); }
+
+namespace {
+template <class T>
+std::size_t bytes(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+template <class T, std::size_t N>
+std::size_t bytes(const std::array<std::vector<T>, N>& arrays) {
+  std::size_t total = 0;
+  for (const std::vector<T>& v : arrays) total += bytes(v);
+  return total;
+}
+}  // namespace
+
+std::size_t World::memoryBytes() const {
+  std::size_t total = 0;
+  for (const Cloth& cloth : cloths_) {
+    total += bytes(cloth.rest.restPositions) + bytes(cloth.rest.triangles) + bytes(cloth.rest.constraints);
+    const ParticleState& s = cloth.state;
+    total += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) + bytes(s.mass) +
+             bytes(s.pinned);
+    const Topology& t = cloth.topology;
+    total += bytes(t.neighbour) + bytes(t.triangleArea) + bytes(t.templates) + bytes(t.source);
+    total += bytes(cloth.piece);
+  }
+  for (const SolverScratch& s : scratch_) {
+    total += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
+             bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
+             bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.tethers) + bytes(s.looseStretch) + bytes(s.lineNormal) +
+             bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.batchStart);
+    for (const SolverScratch::LineFamily& f : s.lines) {
+      total += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda);
+    }
+  }
+  for (const Snapshot& snapshot : lastGood_) {
+    total += bytes(snapshot.position) + bytes(snapshot.previousPosition) + bytes(snapshot.velocity);
+  }
+  for (const std::vector<std::uint8_t>& held : held_) total += bytes(held);
+  const SelfCollisionScratch& h = selfCollisionScratch_;
+  total += bytes(h.owner) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
+  return total;
+}
+
+std::size_t World::tetherCount() const {
+  std::size_t n = 0;
+  for (const SolverScratch& s : scratch_) n += s.tethers.size();
+  return n;
+}
+
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
 bool World::hasStage(Stage stage) const {
   for (const StageTiming& timing : profile_) {
     if (timing.stage == stage) return true;
@@ -319,11 +409,12 @@ void World::runStage(Stage stage) {
     switch (stage) {
       case Stage::windPressure: position::accumulateWindPressure(cloth, settings_.air, h, scratch.acceleration); break;
       case Stage::verletIntegrate:
-        position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration);
+        position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration,
+                            *workers_);
         break;
       case Stage::projectConstraints:
-        position::projectConstraints(cloth, settings_.solver.iterations, h, settings_.solver.xpbd, scratch,
-                                     !colliders_.empty());
+        plan(c);
+        position::projectConstraints(cloth, settings_.solver, h, scratch, !colliders_.empty(), *workers_);
         break;
       case Stage::dampConstraints: position::dampConstraints(cloth); break;
       case Stage::clampTravel:
@@ -675,6 +766,7 @@ void World::tune(const WorldSettings& next) {
     colliders_[i] = Collider(settings_.colliders[i]);
     colliders_[i].setTime(time());
   }
+  for (SolverScratch& scratch : scratch_) scratch.planVersion = 0;  // lines may have been switched
   if (tethersChanged) {
     for (std::size_t c = 0; c < cloths_.size(); ++c) {
       scratch_[c].tethers.clear();

@@ -10,7 +10,8 @@ double freeFallError(int substeps);
 // Position model: a chain of `links` links, 1.2 m long, hung between two pins 1 m apart, settled
 // (10 s, drag 2/s): the largest vertical distance of a particle from the catenary of that length
 // and span, y = a cosh(x / a) + c with 2 a sinh(s / 2a) = L (m); `strain` gets the worst edge's.
-double catenaryError(int links, int iterations, double* strain = nullptr);
+// With `lines`, the chain is solved a line at a time (sim::SolverSettings::lines).
+double catenaryError(int links, int iterations, double* strain = nullptr, bool lines = false);
 
 // Position model: a rigid pendulum of length 1 m (one link, a 1 kg bob) released horizontally; the
 // error of the time it takes to swing to the bottom (s) against the exact nonlinear quarter period

@@ -47,6 +47,11 @@ struct SolverSettings {
   // Position model: long-range attachments (Kim, Chentanez, Mueller 2012): no particle may be
   // farther from a pin than it is at rest. One cheap inequality per particle and pin.
   bool tethers = false;
+  // Position model: each row and column of stretch constraints is solved at once, exactly for its
+  // linearised constraints (a tridiagonal system, as Goldenthal et al. 2007 do for the whole
+  // cloth), instead of one constraint at a time. A sweep then carries a correction along the whole
+  // line, where Gauss-Seidel carries it one particle.
+  bool lines = false;
 };
 
 // The air around the cloth, moving uniformly at `velocity`.

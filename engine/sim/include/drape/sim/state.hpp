@@ -47,6 +47,25 @@ struct SolverScratch {
     Real length;
   };
   std::vector<Tether> tethers;
+  // Lines (solver.lines): the stretch constraints as chains, rows and columns on a lattice, each
+  // solved at once (lines.hpp). Built from the constraints whenever they change.
+  struct LineFamily {
+    std::vector<std::uint32_t> start;  // line l holds particle[start[l] .. start[l + 1])
+    std::vector<ParticleIndex> particle;
+    std::vector<Real> rest;    // m, link k joins particle[k] and particle[k + 1] (unused at a line's end)
+    std::vector<Real> lambda;  // XPBD: multiplier of link k, reset each substep
+  };
+  std::array<LineFamily, 2> lines;          // along x, and across
+  std::vector<std::uint32_t> looseStretch;  // stretch constraints in no line: solved one by one
+  // Working arrays of the line solves, as long as the longest line, one slice per thread.
+  std::size_t lineStride = 0;
+  std::vector<Vec3> lineNormal;
+  std::vector<Real> lineUpper, lineSolution;
+  // Each kind's constraints come in batches that share no particle (batches.hpp): batch b is
+  // [batchStart[b], batchStart[b + 1]); with sequentialTail the last batch is not one.
+  std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;
+  std::array<bool, kConstraintKindCount> sequentialTail{};
+  std::uint64_t planVersion = 0;  // the world's topology version the batches and lines were made for
 };
 
 // The self-collision spatial hash over every particle of a world.

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -51,10 +52,26 @@ struct Divergence {
 
 enum class StepStatus : std::uint8_t { ok, diverged };
 
+class Workers;
+
+inline constexpr int kMaxThreads = 64;
+
 class World {
  public:
   // Throws std::invalid_argument if the settings are outside what the engine accepts.
   explicit World(WorldSettings settings);
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+
+  // How many threads step the world (1 at first). The result is the same bit for bit whatever the
+  // number. Throws std::invalid_argument outside 1..kMaxThreads.
+  void setThreads(int threads);
+  int threads() const;
+  // Bytes the world keeps for its cloths (every array's capacity: state, rest data, constraints,
+  // solver scratch, the guard's copy of the last good state).
+  std::size_t memoryBytes() const;
+  std::size_t tetherCount() const;
 
   StepStatus step();
   StepStatus run(std::int64_t steps);
@@ -128,6 +145,7 @@ class World {
  private:
   void buildPipeline();
   void buildTethers(std::size_t cloth);
+  void plan(std::size_t cloth);  // batches and lines for the cloth's current constraints
   void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits);
   void moveFingers(Real h);
   void tear();
@@ -157,6 +175,7 @@ class World {
   std::vector<Snapshot> lastGood_;  // what the current step changes, as it was before it
   std::vector<Finger> fingers_;
   std::vector<std::vector<std::uint8_t>> held_;  // per cloth and particle: 1 while a finger holds it
+  std::unique_ptr<Workers> workers_;
 };
 
 }  // namespace drape::sim

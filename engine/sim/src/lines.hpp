@@ -1,0 +1,30 @@
+// Lines: a cloth's stretch constraints gathered into chains (rows and columns on a lattice), each
+// chain solved at once. For a chain of links k joining particles k and k + 1 with
+// C_k = |x_{k+1} - x_k| - r_k and unit directions n_k, the linearised system
+//   (J W J^T + alpha~) dlambda = -C - alpha~ lambda
+// is tridiagonal: diagonal w_k + w_{k+1} + alpha~, off-diagonal -w_{k+1} (n_k . n_{k+1}); then
+//   dx_k = w_k (dlambda_{k-1} n_{k-1} - dlambda_k n_k).
+// It is solved in O(links) (Thomas' algorithm; the matrix is symmetric positive definite). Where
+// Gauss-Seidel moves a correction one particle per sweep, this moves it along the whole line in
+// one: a hanging column of 128 particles is as cheap to keep taut as one of 8.
+#pragma once
+
+#include <cstdint>
+
+#include "drape/sim/world.hpp"
+#include "workers.hpp"
+
+namespace drape::sim::lines {
+
+// Rebuilds scratch.lines and scratch.looseStretch from the cloth's stretch constraints. A link
+// goes to the family of its rest direction (along x, or not) and joins a line there unless that
+// would give a particle three links in the family or close a loop; then it is loose.
+void build(const Cloth& cloth, SolverScratch& scratch, int threads);
+
+// One sweep over every line of both families, then the loose stretch constraints one by one.
+// `stiffness` scales each correction (position model); with `xpbd`, alphaTilde = compliance / h^2
+// enters the system and scratch lambdas accumulate.
+// The lines of a family are independent: they are shared among the workers.
+void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, Workers& workers);
+
+}  // namespace drape::sim::lines

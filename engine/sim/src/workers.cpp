@@ -1,0 +1,81 @@
+#include "workers.hpp"
+
+#include <algorithm>
+
+namespace drape::sim {
+
+namespace {
+constexpr int kSpins = 20000;  // about 50 microseconds of polling before a helper sleeps
+
+// One round of polling. Every 64th gives the core away, so that more threads than cores (or a
+// busy machine) still make progress.
+void pause(int round) {
+  if (round % 64 == 63) {
+    std::this_thread::yield();
+    return;
+  }
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
+std::pair<std::size_t, std::size_t> chunk(std::size_t n, int parts, int index) {
+  const std::size_t begin = n * static_cast<std::size_t>(index) / static_cast<std::size_t>(parts);
+  const std::size_t end = n * static_cast<std::size_t>(index + 1) / static_cast<std::size_t>(parts);
+  return {begin, end};
+}
+}  // namespace
+
+Workers::Workers(int threads) {
+  for (int i = 1; i < std::max(threads, 1); ++i) helpers_.emplace_back([this, i] { loop(i); });
+}
+
+Workers::~Workers() {
+  stop_.store(true, std::memory_order_release);
+  generation_.fetch_add(1, std::memory_order_release);
+  generation_.notify_all();
+  for (std::thread& helper : helpers_) helper.join();
+}
+
+void Workers::run(std::size_t n, const std::function<void(std::size_t, std::size_t, int)>& f, std::size_t grain) {
+  const int parts = static_cast<int>(std::min<std::size_t>(
+      static_cast<std::size_t>(threads()), std::max<std::size_t>(n / std::max<std::size_t>(grain, 1), 1)));
+  if (parts <= 1) {
+    f(0, n, 0);
+    return;
+  }
+  task_ = &f;
+  items_ = n;
+  active_ = parts;
+  pending_.store(static_cast<int>(helpers_.size()), std::memory_order_relaxed);
+  generation_.fetch_add(1, std::memory_order_release);
+  generation_.notify_all();
+  const auto [begin, end] = chunk(n, parts, 0);
+  f(begin, end, 0);
+  for (int round = 0; pending_.load(std::memory_order_acquire) != 0; ++round) pause(round);
+  task_ = nullptr;
+}
+
+void Workers::loop(int index) {
+  std::uint64_t seen = 0;
+  while (true) {
+    std::uint64_t now = generation_.load(std::memory_order_acquire);
+    for (int spin = 0; now == seen && spin < kSpins; ++spin) {
+      pause(spin);
+      now = generation_.load(std::memory_order_acquire);
+    }
+    if (now == seen) {
+      generation_.wait(seen, std::memory_order_acquire);
+      continue;
+    }
+    seen = now;
+    if (stop_.load(std::memory_order_acquire)) return;
+    if (index < active_) {
+      const auto [begin, end] = chunk(items_, active_, index);
+      (*task_)(begin, end, index);
+    }
+    pending_.fetch_sub(1, std::memory_order_acq_rel);
+  }
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,352 @@
+// The fast solver's parts: lines, lens tethers, batches, threads.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <tuple>
+
+#include <glm/geometric.hpp>
+
+#include "batches.hpp"
+#include "drape/sim/metrics.hpp"
+#include "drape/sim/world.hpp"
+#include "lines.hpp"
+#include "workers.hpp"
+#include "world_builder.hpp"
+
+namespace drape::sim {
+namespace {
+
+// A chain of n particles along x, particle 0 pinned, built as a world's cloth (a 1-row lattice).
+Cloth chain(int n, Real length) {
+  WorldSettings settings;
+  settings.cloths.push_back(test::chainCloth(n, 1, length, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz, {1.0, 0.0}));
+  settings.cloths[0].pins.push_back({0, 0, std::nullopt});
+  World world(settings);
+  return world.cloths()[0];
+}
+
+Real worstViolation(const Cloth& cloth) {
+  Real worst = 0.0;
+  for (const DistanceConstraint& c : cloth.rest.of(ConstraintKind::stretch)) {
+    worst =
+        std::max(worst, std::abs(glm::length(cloth.state.position[c.b] - cloth.state.position[c.a]) - c.restLength));
+  }
+  return worst;
+}
+
+TEST(Lines, AChainIsOneLine) {
+  Cloth cloth = chain(30, 1.0);
+  SolverScratch scratch;
+  lines::build(cloth, scratch, 1);
+  ASSERT_EQ(scratch.lines[0].start.size(), 2u);  // one line along x
+  EXPECT_EQ(scratch.lines[0].particle.size(), 30u);
+  EXPECT_TRUE(scratch.looseStretch.empty());
+  EXPECT_EQ(scratch.lines[1].particle.size(), 0u);
+}
+
+TEST(Lines, ALatticeIsRowsAndColumns) {
+  WorldSettings settings = test::hangingSheet(9, 1, 1);
+  World world(settings);
+  Cloth cloth = world.cloths()[0];
+  SolverScratch scratch;
+  lines::build(cloth, scratch, 1);
+  EXPECT_EQ(scratch.lines[0].start.size(), 10u);  // 9 rows
+  EXPECT_EQ(scratch.lines[1].start.size(), 10u);  // 9 columns
+  EXPECT_EQ(scratch.lines[0].particle.size() + scratch.lines[1].particle.size(), 2u * 81u);
+  EXPECT_TRUE(scratch.looseStretch.empty());
+}
+
+TEST(Lines, AStraightStretchedChainIsExactInOneSolve) {
+  // Along a straight line the constraints are linear in the positions: one solve is exact.
+  Cloth cloth = chain(40, 1.0);
+  for (std::size_t i = 0; i < cloth.state.position.size(); ++i) cloth.state.position[i].x *= 1.3;
+  SolverScratch scratch;
+  lines::build(cloth, scratch, 1);
+  Workers workers(1);
+  ASSERT_GT(worstViolation(cloth), 0.005);
+  lines::solve(cloth, scratch, 1.0, false, 0.0, workers);
+  EXPECT_LT(worstViolation(cloth), 1e-12);
+  // Particle 0 is pinned and stays; the last is back at 1 m.
+  EXPECT_EQ(cloth.state.position[0], Vec3(0.0));
+  EXPECT_NEAR(cloth.state.position.back().x, 1.0, 1e-12);
+}
+
+TEST(Lines, ABentChainConvergesQuadratically) {
+  // Newton's method on the chain's constraints (errors of 4 % of a link): the first solve takes off
+  // more than 98 % of the worst error and the second all but 0.1 %, where a Gauss-Seidel sweep
+  // leaves more than a third. (Quadratic in the end, with a large constant: a correction at the
+  // pinned end moves the whole chain.)
+  Cloth cloth = chain(60, 1.0);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<Real> jitter(-0.0004, 0.0004);
+  for (std::size_t i = 1; i < cloth.state.position.size(); ++i) {
+    cloth.state.position[i] +=
+        Vec3{jitter(random), jitter(random) + 0.001 * std::sin(0.3 * static_cast<Real>(i)), jitter(random)};
+  }
+  Cloth byGaussSeidel = cloth;
+  SolverScratch scratch;
+  lines::build(cloth, scratch, 1);
+  Workers workers(1);
+  const Real before = worstViolation(cloth);
+  lines::solve(cloth, scratch, 1.0, false, 0.0, workers);
+  const Real once = worstViolation(cloth);
+  lines::solve(cloth, scratch, 1.0, false, 0.0, workers);
+  const Real twice = worstViolation(cloth);
+  for (const DistanceConstraint& c : byGaussSeidel.rest.of(ConstraintKind::stretch)) {
+    Vec3& a = byGaussSeidel.state.position[c.a];
+    Vec3& b = byGaussSeidel.state.position[c.b];
+    const Real wa = byGaussSeidel.state.inverseMass[c.a], wb = byGaussSeidel.state.inverseMass[c.b];
+    const Vec3 d = b - a;
+    const Real length = glm::length(d);
+    const Vec3 correction = d * ((length - c.restLength) / (length * (wa + wb)));
+    a += wa * correction;
+    b -= wb * correction;
+  }
+  EXPECT_LT(once, 0.02 * before);
+  EXPECT_LT(twice, 1e-3 * before);
+  EXPECT_GT(worstViolation(byGaussSeidel), 0.3 * before);
+}
+
+// ---- batches --------------------------------------------------------------------------------
+
+TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
+  World world(test::hangingSheet(17, 1, 1));
+  ClothRest rest = world.cloths()[0].rest;
+  const ClothRest before = rest;
+  const batches::Batches made = batches::colour(rest);
+  for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
+    const std::vector<DistanceConstraint>& constraints = rest.constraints[kind];
+    // The same constraints, reordered.
+    ASSERT_EQ(constraints.size(), before.constraints[kind].size());
+    std::vector<std::tuple<ParticleIndex, ParticleIndex, Real>> a, b;
+    for (const DistanceConstraint& c : constraints) a.emplace_back(c.a, c.b, c.restLength);
+    for (const DistanceConstraint& c : before.constraints[kind]) b.emplace_back(c.a, c.b, c.restLength);
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    const std::vector<std::uint32_t>& start = made.start[kind];
+    ASSERT_GE(start.size(), 2u);
+    EXPECT_EQ(start.back(), constraints.size());
+    EXPECT_LE(start.size() - 1, 8u);  // a lattice needs few colours
+    EXPECT_FALSE(made.sequentialTail[kind]);
+    for (std::size_t batch = 0; batch + 1 < start.size(); ++batch) {
+      std::vector<int> seen(rest.particleCount(), 0);
+      for (std::uint32_t k = start[batch]; k < start[batch + 1]; ++k) {
+        EXPECT_EQ(seen[constraints[k].a]++, 0);
+        EXPECT_EQ(seen[constraints[k].b]++, 0);
+      }
+    }
+  }
+  // Colouring what is already coloured changes nothing.
+  ClothRest again = rest;
+  batches::colour(again);
+  for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
+    for (std::size_t k = 0; k < rest.constraints[kind].size(); ++k) {
+      EXPECT_EQ(again.constraints[kind][k].a, rest.constraints[kind][k].a);
+      EXPECT_EQ(again.constraints[kind][k].b, rest.constraints[kind][k].b);
+    }
+  }
+}
+
+TEST(Batches, AParticleWithMoreThan63ConstraintsGoesToASequentialTail) {
+  // A star: one particle joined to 100 others. Only one of its constraints fits in each batch.
+  ClothRest rest;
+  rest.restPositions.assign(101, Vec3{0.0});
+  for (ParticleIndex i = 1; i <= 100; ++i) {
+    rest.restPositions[i] = Vec3{static_cast<Real>(i), 0.0, 0.0};
+    rest.constraints[0].push_back({0, i, static_cast<Real>(i)});
+  }
+  const batches::Batches made = batches::colour(rest);
+  EXPECT_TRUE(made.sequentialTail[0]);
+  EXPECT_EQ(made.start[0].size() - 1, 64u);  // 63 batches of one, and the tail
+  EXPECT_EQ(made.start[0][63], 63u);
+}
+
+// ---- workers --------------------------------------------------------------------------------
+
+TEST(Workers, EveryItemIsVisitedOnceWhateverTheThreads) {
+  for (int threads : {1, 2, 3, 8}) {
+    Workers workers(threads);
+    for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{7}, std::size_t{10000}}) {
+      std::vector<int> visits(n, 0);
+      std::vector<int> byThread(static_cast<std::size_t>(threads), 0);
+      workers.run(
+          n,
+          [&](std::size_t begin, std::size_t end, int thread) {
+            for (std::size_t i = begin; i < end; ++i) ++visits[i];
+            byThread[static_cast<std::size_t>(thread)] += static_cast<int>(end - begin);
+          },
+          16);
+      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(visits[i], 1) << threads << " threads, n = " << n;
+      if (n == 10000) {
+        for (int count : byThread) EXPECT_GT(count, 0);  // the work was shared
+      }
+    }
+  }
+}
+
+// ---- lens tethers ----------------------------------------------------------------------------
+
+// A single free particle tethered to two pins.
+WorldSettings twoTethers(Vec3 pinA, Vec3 pinB) {
+  WorldSettings world;
+  world.solver.tethers = true;
+  world.solver.iterations = 1;
+  world.gravity = Vec3{0.0};
+  // The stretch constraints are all but off (they only make the chain one piece, which tethers need).
+  ClothSettings cloth = test::chainCloth(3, 1, 2.0, 1.0, 3.0, Vec3{0.0}, LatticePlane::xz, {1e-12, 0.0});
+  cloth.pins = {{0, 0, pinA}, {2, 0, pinB}};
+  world.cloths.push_back(cloth);
+  return world;
+}
+
+TEST(Tethers, AParticleBetweenTwoPinsAtItsRestDistancesStaysOnTheSegment) {
+  // The middle of a 3-particle chain, rest 1 m from each pin, pins 2 m apart: its tethers allow one
+  // point only. Projected onto one ball and then the other it would creep there; the lens
+  // projection puts it there in one sweep.
+  World world(twoTethers(Vec3{0.0}, Vec3{2.0, 0.0, 0.0}));
+  std::vector<Cloth> cloths = world.cloths();
+  cloths[0].state.position[1] = Vec3{1.0, -0.5, 0.3};
+  cloths[0].state.previousPosition[1] = cloths[0].state.position[1];
+  world.restoreCloths(cloths);
+  world.step();
+  const Vec3 x = world.cloths()[0].state.position[1];
+  EXPECT_NEAR(x.x, 1.0, 1e-9);
+  EXPECT_NEAR(x.y, 0.0, 1e-9);
+  EXPECT_NEAR(x.z, 0.0, 1e-9);
+}
+
+TEST(Tethers, TheLensProjectionIsTheNearestPointInBothBalls) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<Real> coordinate(-2.0, 2.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vec3 a{0.0}, b{1.5, 0.0, 0.0};
+    WorldSettings settings = twoTethers(a, b);
+    World world(settings);
+    std::vector<Cloth> cloths = world.cloths();
+    const Vec3 start{coordinate(random), coordinate(random), coordinate(random)};
+    cloths[0].state.position[1] = start;
+    cloths[0].state.previousPosition[1] = start;
+    world.restoreCloths(cloths);
+    world.step();
+    const Vec3 x = world.cloths()[0].state.position[1];
+    // Rest distances: 1 m from each pin (the lattice is 2 m wide).
+    ASSERT_LE(glm::length(x - a), 1.0 + 1e-9);
+    ASSERT_LE(glm::length(x - b), 1.0 + 1e-9);
+    // No point of the lens found by sampling is nearer to where the particle was.
+    const Real distance = glm::length(x - start);
+    for (int sample = 0; sample < 400; ++sample) {
+      const Vec3 q{coordinate(random) * 0.5 + 0.75, coordinate(random) * 0.5, coordinate(random) * 0.5};
+      if (glm::length(q - a) > 1.0 || glm::length(q - b) > 1.0) continue;
+      ASSERT_GE(glm::length(q - start), distance - 1e-9) << "trial " << trial;
+    }
+  }
+}
+
+// ---- the fast sweep as a whole ---------------------------------------------------------------
+
+WorldSettings fastSheet(int n, int substeps) {
+  WorldSettings world = test::hangingSheet(n, 1, substeps);
+  world.solver.lines = true;
+  world.solver.tethers = true;
+  for (ConstraintKind kind : kConstraintKinds) world.cloths[0].material(kind) = {1.0, 0.0};
+  return world;
+}
+
+std::vector<Vec3> positionsAfter(WorldSettings settings, int threads, int steps) {
+  World world(std::move(settings));
+  world.setThreads(threads);
+  world.run(steps);
+  std::vector<Vec3> all;
+  for (const Cloth& cloth : world.cloths())
+    all.insert(all.end(), cloth.state.position.begin(), cloth.state.position.end());
+  return all;
+}
+
+TEST(FastSweep, OneTwoOrFiveThreadsGiveTheSameResultBitForBit) {
+  const WorldSettings settings = fastSheet(48, 4);
+  const std::vector<Vec3> one = positionsAfter(settings, 1, 40);
+  EXPECT_EQ(positionsAfter(settings, 2, 40), one);
+  EXPECT_EQ(positionsAfter(settings, 5, 40), one);
+}
+
+TEST(FastSweep, ThreadsStayBitIdenticalThroughTearingAndXpbd) {
+  WorldSettings settings = fastSheet(32, 2);
+  settings.solver.xpbd = true;
+  settings.cloths[0].material(ConstraintKind::stretch).compliance = 1e-2;  // soft: it stretches and tears
+  settings.tearing = {true, 1.05};
+  World probe(settings);
+  probe.run(60);
+  ASSERT_GT(probe.cloths()[0].pieceCount, 1u) << "the test needs a tear";
+  const std::vector<Vec3> one = positionsAfter(settings, 1, 60);
+  EXPECT_EQ(positionsAfter(settings, 2, 60), one);
+  EXPECT_EQ(positionsAfter(settings, 3, 60), one);
+}
+
+TEST(FastSweep, KeepsTheHangingSheetTautWhereGaussSeidelLetsItStretch) {
+  // hang2 at 64 x 64 for two seconds, 4 substeps of one sweep: whole lines keep the worst edge under
+  // 1 %, the seed's sweep (with the same tethers) leaves it stretched by more than 5 %.
+  WorldSettings fast = fastSheet(64, 4);
+  WorldSettings seed = fast;
+  seed.solver.lines = false;
+  World a(fast), b(seed);
+  a.run(120);
+  b.run(120);
+  EXPECT_LT(structuralStrain(a).max, 0.01);
+  EXPECT_GT(structuralStrain(b).max, 0.05);
+}
+
+TEST(FastSweep, XpbdLinesStretchAHangingChainAsItsComplianceSays) {
+  // A vertical chain of 20 links, 0.1 kg each particle, compliance 1e-3 m/N: at rest link k
+  // carries the weight of the particles below it and stretches by compliance * weight.
+  WorldSettings world;
+  world.solver.lines = true;
+  world.solver.xpbd = true;
+  world.solver.substeps = 10;
+  world.solver.iterations = 2;
+  world.air.drag = 5.0;
+  const int links = 20;
+  const Real mass = 0.1 * (links + 1), compliance = 1e-3;
+  ClothSettings cloth =
+      test::chainCloth(1, links + 1, 1.0, 2.0, mass, Vec3{0.0, 3.0, 0.0}, LatticePlane::xy, {1.0, 0.0, compliance});
+  cloth.pins = {{0, 0, std::nullopt}};
+  world.cloths.push_back(cloth);
+  World w(world);
+  w.run(600);
+  const ParticleState& s = w.cloths()[0].state;
+  const Real rest = 2.0 / links, g = 9.81;
+  for (int k = 0; k < links; ++k) {
+    const Real below = 0.1 * static_cast<Real>(links - k);  // kg hanging from link k
+    const Real length =
+        glm::length(s.position[static_cast<std::size_t>(k + 1)] - s.position[static_cast<std::size_t>(k)]);
+    EXPECT_NEAR(length - rest, compliance * below * g, 0.01 * compliance * below * g) << "link " << k;
+  }
+}
+
+TEST(FastSweep, MemoryGrowsLinearlyWithTheParticles) {
+  World small(fastSheet(32, 1)), large(fastSheet(64, 1));
+  small.step();
+  large.step();
+  const double perParticleSmall = static_cast<double>(small.memoryBytes()) / (32.0 * 32.0);
+  const double perParticleLarge = static_cast<double>(large.memoryBytes()) / (64.0 * 64.0);
+  EXPECT_NEAR(perParticleLarge, perParticleSmall, 0.15 * perParticleSmall);
+  EXPECT_GT(perParticleSmall, 100.0);  // it counts what it keeps: positions alone are 48 bytes
+}
+
+TEST(FastSweep, ThreadsAreCheckedAndTheStageListStaysBare) {
+  World world(fastSheet(16, 1));
+  EXPECT_THROW(world.setThreads(0), std::invalid_argument);
+  EXPECT_THROW(world.setThreads(65), std::invalid_argument);
+  world.setThreads(2);
+  EXPECT_EQ(world.threads(), 2);
+  // No colliders, no tearing, no fingers, no wind: only what the solver needs.
+  std::vector<Stage> stages;
+  for (const StageTiming& t : world.profile()) stages.push_back(t.stage);
+  EXPECT_EQ(stages, (std::vector<Stage>{Stage::verletIntegrate, Stage::projectConstraints, Stage::guard}));
+}
+
+}  // namespace
+}  // namespace drape::sim
