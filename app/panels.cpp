@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <thread>
 
 #include <imgui.h>
 
@@ -260,7 +261,12 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       changed |= ImGui::Checkbox("XPBD", &tuned.solver.xpbd);
       ImGui::SameLine();
       changed |= ImGui::Checkbox("tethers", &tuned.solver.tethers);
+      ImGui::SameLine();
+      changed |= ImGui::Checkbox("lines", &tuned.solver.lines);
     }
+    int threads = session.threads();
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    if (ImGui::SliderInt("threads", &threads, 1, std::max(cores, 2))) session.setThreads(threads);
     changed |= ImGui::Checkbox("tearing", &tuned.tearing.enabled);
     changed |= sliderReal("tear at (x rest)", tuned.tearing.threshold, 1.01, 5.0);
   }

@@ -1,5 +1,6 @@
 #include "session.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -35,9 +36,15 @@ Session::Session(const std::filesystem::path& scene) {
   if (const std::optional<std::string> error = load(scene)) throw scene::InputError(*error);
 }
 
+void Session::setThreads(int threads) {
+  threads_ = std::clamp(threads, 1, sim::kMaxThreads);
+  world_->setThreads(threads_);
+}
+
 void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const std::filesystem::path& path) {
   scene_ = std::move(scene);
   world_ = std::move(world);
+  world_->setThreads(threads_);
   path_ = path;
   interaction_ = std::make_unique<interact::Interaction>(*world_);
   interaction_->settings().material = scene::drawnClothTemplate(scene_);

@@ -66,6 +66,10 @@ class Session {
   render::Camera& camera() { return camera_; }
   const std::filesystem::path& path() const { return path_; }
 
+  // Threads that step the world (the result is the same whatever the number); kept across loads.
+  void setThreads(int threads);
+  int threads() const { return threads_; }
+
   bool paused = false;
   std::string status;  // the last thing worth telling the user (shown in the HUD)
 
@@ -83,6 +87,7 @@ class Session {
   std::unique_ptr<interact::Interaction> interaction_;
   render::Camera camera_;
   std::vector<Undo> undo_;
+  int threads_ = 1;
 };
 
 }  // namespace drape::app

@@ -341,6 +341,57 @@ TEST_F(Cli, StudyReportsErrorAgainstTimeWithAParetoFront) {
   expectOneLineError(run("study chain --sweep solver.substeps"), 2, "--sweep solver.substeps: expected path=value1");
 }
 
+TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
+  const fs::path folder = file("performance"), report = file("performance.md");
+  const Result result = run("bench --quick --scenes hang2-tear --quiet --out-dir '" + folder.string() + "' --report '" +
+                            report.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(fs::exists(folder / "performance.png"));
+  std::istringstream csv(read(folder / "performance.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line,
+            "scene,n,particles,solver,threads,substeps,iterations,ms_per_frame,ms_per_frame_min,projections_per_s,"
+            "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle");
+  int drape = 0, naive = 0, tear = 0;
+  double drapeStrain = 1.0, naiveStrain = 0.0;
+  while (std::getline(csv, line)) {
+    char scene[32], solver[16];
+    int n, threads;
+    double strainEnd;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%31[^,],%d,%*d,%15[^,],%d,%*d,%*d,%*f,%*f,%*f,%lf", scene, &n, solver,
+                          &threads, &strainEnd),
+              5)
+        << line;
+    if (std::string(scene) == "hang2-tear") ++tear;
+    if (std::string(scene) != "hang2" || n != 24) continue;
+    if (std::string(solver) == "drape") {
+      ++drape;
+      drapeStrain = strainEnd;
+    } else {
+      ++naive;
+      naiveStrain = strainEnd;
+    }
+  }
+  EXPECT_EQ(drape, 2);  // one and two threads
+  EXPECT_EQ(naive, 1);
+  EXPECT_EQ(tear, 2);
+  // The measurement, not the speed: the fast sweep holds the sheet where ten naive sweeps do not.
+  EXPECT_LT(drapeStrain, 0.05);
+  EXPECT_GT(naiveStrain, 0.05);
+  const std::string text = read(report);
+  EXPECT_NE(text.find("## Against the naive baseline"), std::string::npos);
+  EXPECT_NE(text.find("verlet integrate"), std::string::npos);  // the stages, by name
+}
+
+TEST_F(Cli, BenchRefusesBadValuesWithOneLine) {
+  expectOneLineError(run("bench --quick --scenes no-such-scene --out-dir '" + file("p").string() + "'"), 2,
+                     "no-such-scene");
+  expectOneLineError(run("bench --sizes 1"), 2, "--sizes");
+  expectOneLineError(run("bench --threads 0"), 2, "--threads");
+  EXPECT_FALSE(fs::exists(file("p")));
+}
+
 TEST_F(Cli, AStepCountPastTheLimitIsBadInput) {
   expectOneLineError(run("run hang --set duration=100000 --set solver.dt=1e-6"), 2,
                      "duration / solver.dt asks for 100000000000 steps, more than the limit of 1000000000");

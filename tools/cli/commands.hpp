@@ -64,7 +64,22 @@ struct StudyArguments {
   bool quiet = false;
 };
 
+struct BenchArguments {
+  std::vector<int> sizes{64, 128, 256};                           // hang2 N
+  std::vector<int> threads{1, 2};                                 // Drape's solver on this many threads
+  std::vector<int> naiveIterations{10, 200};                      // the naive baseline's sweeps per frame
+  std::vector<std::string> scenes{"drape-sphere", "hang2-tear"};  // more scenes (Drape's solver only)
+  int frames = 120;
+  int repeats = 3;     // timed runs (median); fewer once a case has taken 20 s
+  int substeps = 0;    // Drape's hang2 substeps (of one sweep); 0: the fewest that keep strain within 5 %
+  bool quick = false;  // a smoke test: small sizes, few frames
+  std::string outDir = "performance";
+  std::optional<std::string> report;
+  bool quiet = false;
+};
+
 int validate(const SceneArguments& arguments);
+int bench(const BenchArguments& arguments);
 int study(const StudyArguments& arguments);
 int stability(const StabilityArguments& arguments);
 int render(const RenderArguments& arguments);

@@ -102,6 +102,33 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100));
   addReportOptions(studyCommand, studyArguments.outDir, studyArguments.report, studyArguments.quiet);
 
+  BenchArguments benchArguments;
+  CLI::App* benchCommand = app.add_subcommand(
+      "bench", "Time the solver on hang2 (N x N) and more scenes, against the naive baseline; write a report");
+  benchCommand->add_option("--sizes", benchArguments.sizes, "hang2 side N, comma-separated (default 64,128,256)")
+      ->delimiter(',')
+      ->check(CLI::Range(2, 1024));
+  benchCommand->add_option("--threads", benchArguments.threads, "Thread counts (default 1,2)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 64));
+  benchCommand
+      ->add_option("--naive-iterations", benchArguments.naiveIterations,
+                   "The naive baseline's sweeps per frame (default 10,200; empty: no baseline)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 100000));
+  benchCommand->add_option("--scenes", benchArguments.scenes, "More scenes to time (default drape-sphere,hang2-tear)")
+      ->delimiter(',');
+  benchCommand->add_option("--frames", benchArguments.frames, "Frames per run (default 120)")
+      ->check(CLI::Range(1, 100000));
+  benchCommand->add_option("--repeats", benchArguments.repeats, "Timed runs per case (median; default 3)")
+      ->check(CLI::Range(1, 100));
+  benchCommand
+      ->add_option("--substeps", benchArguments.substeps,
+                   "Substeps of Drape's hang2 solver (default: the fewest that keep strain within 5 % at every frame)")
+      ->check(CLI::Range(1, 1000));
+  benchCommand->add_flag("--quick", benchArguments.quick, "Smoke test: N = 16, 24, 10 frames, one repeat");
+  addReportOptions(benchCommand, benchArguments.outDir, benchArguments.report, benchArguments.quiet);
+
   app.add_subcommand("scenes", "List the shipped scenes");
 
   try {
@@ -118,6 +145,7 @@ int main(int argc, char** argv) {
     if (*renderCommand) return render(renderArguments);
     if (*stabilityCommand) return stability(stabilityArguments);
     if (*studyCommand) return study(studyArguments);
+    if (*benchCommand) return bench(benchArguments);
     return listScenes();
   } catch (const std::exception& error) {  // a bug, not bad input: say so rather than abort
     std::cerr << "drape-cli: internal error: " << error.what() << "\n";

@@ -57,11 +57,12 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
   // Thomas' algorithm. Row k couples to link k - 1 by -w_k (n_{k-1} . n_k), to link k + 1 by
   // -w_{k+1} (n_k . n_{k+1}); upper[k] becomes the eliminated upper entry, solution[k] the
   // eliminated right-hand side.
-  std::array<Real, G> previousUpper{}, previousSolution{};
+  // The matrix is symmetric: row k's coupling to link k + 1 is row k + 1's to link k.
+  std::array<Real, G> previousUpper{}, previousSolution{}, previousCoupling{};
   for (std::size_t k = 0; k < links; ++k) {
     for (std::size_t g = 0; g < G; ++g) {
       const std::size_t at = k * G + g;
-      const Real lower = k > 0 ? -w[p[g][k]] * glm::dot(normal[at - G], normal[at]) : 0.0;
+      const Real lower = previousCoupling[g];
       const Real diagonal = upper[at];
       Real pivot = diagonal - lower * previousUpper[g];
       // Only a particle caught between two immovable ones on a straight line makes the system
@@ -69,6 +70,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
       if (!(pivot > 1e-9 * diagonal)) pivot = diagonal;
       const Real inverse = 1.0 / pivot;
       const Real coupling = k + 1 < links ? -w[p[g][k + 1]] * glm::dot(normal[at], normal[at + G]) : 0.0;
+      previousCoupling[g] = coupling;
       upper[at] = coupling * inverse;
       solution[at] = (solution[at] - lower * previousSolution[g]) * inverse;
       previousUpper[g] = upper[at];
@@ -195,14 +197,18 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
   for (int step = 0; step < kNewtonSteps; ++step) {
     for (SolverScratch::LineFamily& lines : scratch.lines) {
       if (lines.start.size() < 2) continue;
+      const std::size_t count = lines.start.size() - 1;
+      // Shared out only where each thread gets a few thousand links: below that, waking a helper
+      // costs more than it saves.
+      const std::size_t perLine = std::max<std::size_t>(lines.particle.size() / count, 1);
       workers.run(
-          lines.start.size() - 1,
+          count,
           [&](std::size_t first, std::size_t last, int thread) {
             const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
             solveFamily(s, lines, first, last, stiffness, xpbd, alphaTilde, scratch.lineNormal.data() + slice,
                         scratch.lineUpper.data() + slice, scratch.lineSolution.data() + slice);
           },
-          8);
+          std::max<std::size_t>(2048 / perLine, 1));
     }
   }
   const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);

@@ -1,0 +1,43 @@
+// Measuring a solver on a scene: wall time per simulated frame, constraint projections per
+// second, the strain it reaches, the bytes it keeps.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "drape/sim/settings.hpp"
+
+namespace drape::bench {
+
+struct Measurement {
+  std::string solver;  // "drape" or "naive"
+  int threads = 1;
+  int substeps = 1;
+  int iterations = 1;
+  std::size_t particles = 0;
+  std::size_t constraints = 0;  // stretch + shear + bend
+  std::size_t tethers = 0;
+  int frames = 0;
+  double msPerFrame = 0.0;  // wall time, median over the repeats
+  double msPerFrameMin = 0.0;
+  double projectionsPerSecond = 0.0;  // constraints (and tethers) projected per second of wall time
+  double strainMaxEnd = 0.0;          // structural strain after the last frame
+  double strainMeanEnd = 0.0;
+  double strainMaxRun = 0.0;  // worst structural strain after any frame
+  bool diverged = false;      // non-finite (naive) or stopped by the guard (drape)
+  std::size_t bytes = 0;      // what the solver keeps for the cloth: state, rest data, constraints, scratch
+  // drape: ms per frame in each pipeline stage, then "(step)": the whole step, stages and the rest
+  std::vector<std::pair<std::string, double>> stageMs;
+};
+
+// Drape's world. Every run times its steps alone; the first also takes the strain after each
+// frame (the trajectory is the same bit for bit in every run). Up to `repeats` runs, fewer once the
+// case has taken 20 s.
+Measurement measureWorld(const sim::WorldSettings& world, int frames, int threads, int repeats);
+
+// The naive baseline (naive.hpp) on the world's first cloth.
+Measurement measureNaive(const sim::WorldSettings& world, int frames, int iterations, int repeats);
+
+}  // namespace drape::bench

@@ -1,0 +1,94 @@
+#include "drape/bench/naive.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "drape/sim/cloth.hpp"
+
+namespace drape::bench {
+
+NaiveCloth::NaiveCloth(const sim::WorldSettings& world, int iterations)
+    : gravity_(world.gravity), dt_(world.solver.dt), iterations_(iterations) {
+  const sim::ClothSettings& cloth = world.cloths.at(0);
+  const sim::ClothRest rest = sim::buildLattice(cloth.lattice);
+  const sim::Real particleMass = cloth.mass / static_cast<sim::Real>(rest.particleCount());
+  for (const sim::Vec3& x : rest.restPositions) particles_.push_back({x, x, 1.0 / particleMass});
+  for (sim::ConstraintKind kind : sim::kConstraintKinds) {
+    const sim::Real stiffness = cloth.material(kind).stiffness;
+    if (stiffness == 0.0) continue;
+    for (const sim::DistanceConstraint& c : rest.of(kind)) {
+      constraints_.push_back({static_cast<int>(c.a), static_cast<int>(c.b), c.restLength, stiffness});
+    }
+    if (kind == sim::ConstraintKind::stretch) structural_ = constraints_.size();
+  }
+  for (const sim::Pin& pin : cloth.pins) {
+    const int i = static_cast<int>(rest.index(pin.column, pin.row));
+    particles_[static_cast<std::size_t>(i)].inverseMass = 0.0;
+    pinIndex_.push_back(i);
+    pinned_.push_back(particles_[static_cast<std::size_t>(i)].position);
+  }
+}
+
+void NaiveCloth::step() {
+  const sim::Vec3 gravityStep = gravity_ * (dt_ * dt_);
+  for (Particle& p : particles_) {
+    if (p.inverseMass == 0.0) continue;
+    const sim::Vec3 x = p.position;
+    p.position = x + (x - p.previous) + gravityStep;
+    p.previous = x;
+  }
+  for (int iteration = 0; iteration < iterations_; ++iteration) {
+    for (const Constraint& c : constraints_) {
+      Particle& a = particles_[static_cast<std::size_t>(c.a)];
+      Particle& b = particles_[static_cast<std::size_t>(c.b)];
+      const sim::Real wSum = a.inverseMass + b.inverseMass;
+      if (wSum == 0.0) continue;
+      const sim::Vec3 d = b.position - a.position;
+      const sim::Real length = glm::length(d);
+      if (length == 0.0) continue;
+      const sim::Vec3 correction = d * (c.stiffness * (length - c.rest) / (length * wSum));
+      a.position += a.inverseMass * correction;
+      b.position -= b.inverseMass * correction;
+    }
+    for (std::size_t k = 0; k < pinIndex_.size(); ++k) {
+      particles_[static_cast<std::size_t>(pinIndex_[k])].position = pinned_[k];
+    }
+  }
+}
+
+double NaiveCloth::strainMax() const {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < structural_; ++k) {
+    const Constraint& c = constraints_[k];
+    const double length = glm::length(particles_[static_cast<std::size_t>(c.b)].position -
+                                      particles_[static_cast<std::size_t>(c.a)].position);
+    worst = std::max(worst, length / c.rest - 1.0);
+  }
+  return worst;
+}
+
+double NaiveCloth::strainMean() const {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < structural_; ++k) {
+    const Constraint& c = constraints_[k];
+    const double length = glm::length(particles_[static_cast<std::size_t>(c.b)].position -
+                                      particles_[static_cast<std::size_t>(c.a)].position);
+    sum += std::abs(length / c.rest - 1.0);
+  }
+  return structural_ > 0 ? sum / static_cast<double>(structural_) : 0.0;
+}
+
+bool NaiveCloth::finite() const {
+  return std::all_of(particles_.begin(), particles_.end(), [](const Particle& p) {
+    return std::isfinite(p.position.x) && std::isfinite(p.position.y) && std::isfinite(p.position.z);
+  });
+}
+
+std::size_t NaiveCloth::memoryBytes() const {
+  return particles_.capacity() * sizeof(Particle) + constraints_.capacity() * sizeof(Constraint) +
+         pinned_.capacity() * sizeof(sim::Vec3) + pinIndex_.capacity() * sizeof(int);
+}
+
+}  // namespace drape::bench

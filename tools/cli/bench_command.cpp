@@ -1,0 +1,295 @@
+// drape-cli bench: the solver's speed on the standard scene hang2 (N x N, bench/hang2.hpp) and on
+// more scenes, on one and more threads, against the naive baseline (bench/naive.hpp) in the same
+// run; writes CSV, a gnuplot picture of time against particle count and a Markdown report.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "build_info.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "drape/bench/hang2.hpp"
+#include "drape/bench/measure.hpp"
+#include "drape/scene/error.hpp"
+#include "drape/scene/output.hpp"
+
+namespace drape::cli {
+
+namespace {
+
+constexpr double kStrainTarget = 0.05;  // what real fabric stretches: a few percent
+constexpr int kSubstepChoices[] = {2, 4, 6, 8, 12, 16, 24, 32, 48};
+
+struct Row {
+  std::string scene;
+  int n = 0;  // hang2's N, 0 for other scenes
+  bench::Measurement m;
+};
+
+std::string cpuName() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpuinfo, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const std::size_t colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(colon + 2);
+    }
+  }
+  return "unknown CPU";
+}
+
+std::string format(const char* pattern, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, value);
+  return text;
+}
+
+std::string percent(double strain) { return format("%.2f %%", 100.0 * strain); }
+
+// One block per series (Drape on T threads, the baseline at K sweeps): particles, ms per frame.
+std::string plotData(const std::vector<Row>& rows, const std::vector<int>& threads, const std::vector<int>& sweeps) {
+  std::ostringstream data;
+  const auto block = [&](const char* solver, int key) {
+    data << "# " << solver << ' ' << key << "\n";
+    for (const Row& row : rows) {
+      if (row.n == 0 || row.m.solver != solver) continue;
+      if ((row.m.solver == "drape" ? row.m.threads : row.m.iterations) != key) continue;
+      data << row.m.particles << ' ' << row.m.msPerFrame << "\n";
+    }
+    data << "\n\n";
+  };
+  for (int t : threads) block("drape", t);
+  for (int k : sweeps) block("naive", k);
+  return data.str();
+}
+
+std::string plotScript(const std::filesystem::path& directory, const std::vector<int>& threads,
+                       const std::vector<int>& sweeps) {
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 900,600 font ',11'\n"
+     << "set output '" << (directory / "performance.png").string() << "'\n"
+     << "set logscale xy\nset grid\nset key top left\n"
+     << "set xlabel 'particles (hang2, N x N)'\nset ylabel 'ms per simulated frame (1/60 s)'\n"
+     << "set title 'hang2: wall time per frame against particle count'\n"
+     << "plot ";
+  const std::string data = "'" + (directory / "performance.dat").string() + "'";
+  int index = 0;
+  for (int t : threads) {
+    gp << (index ? ", " : "") << data << " index " << index << " with linespoints lw 2 pt 7 title 'Drape, " << t
+       << (t == 1 ? " thread'" : " threads'");
+    ++index;
+  }
+  for (int k : sweeps) {
+    gp << (index ? ", " : "") << data << " index " << index << " with linespoints dt 2 pt 5 title 'naive Gauss-Seidel, "
+       << k << " sweeps'";
+    ++index;
+  }
+  gp << ", 2.5e-4*x with lines dt 3 lc 'gray' title 'linear in particles'\n";
+  return gp.str();
+}
+
+}  // namespace
+
+int bench(const BenchArguments& input) {
+  try {
+    BenchArguments arguments = input;
+    if (arguments.quick) {
+      arguments.sizes = {16, 24};
+      arguments.frames = 10;
+      arguments.repeats = 1;
+      arguments.naiveIterations = {10};
+    }
+    for (int n : arguments.sizes) {
+      if (n < 2 || n > 1024) throw scene::InputError("--sizes: " + std::to_string(n) + " is not between 2 and 1024");
+    }
+    // Every scene is read before anything runs: a bad name fails at once.
+    std::vector<scene::Scene> scenes;
+    for (const std::string& name : arguments.scenes) {
+      if (!name.empty()) scenes.push_back(loadScene(SceneArguments{name, {}}));  // --scenes "" runs none
+    }
+    const std::filesystem::path directory = arguments.outDir;
+
+    std::vector<Row> rows;
+    const auto progress = [&](const Row& row) {
+      if (arguments.quiet) return;
+      const bench::Measurement& m = row.m;
+      std::printf(
+          "%-13s %7zu particles  %-5s %2d thread(s) %3d x %-4d %9.3f ms/frame  strain max %7.2f %% (run %7.2f %%)\n",
+          (row.n > 0 ? row.scene + " " + std::to_string(row.n) : row.scene).c_str(), m.particles, m.solver.c_str(),
+          m.threads, m.substeps, m.iterations, m.msPerFrame, 100.0 * m.strainMaxEnd, 100.0 * m.strainMaxRun);
+      std::fflush(stdout);
+    };
+    std::vector<std::pair<int, std::vector<std::pair<int, double>>>> searches;  // N: (substeps, worst strain)
+    for (int n : arguments.sizes) {
+      bench::Hang2Solver solver;
+      if (arguments.substeps > 0) {
+        solver.substeps = arguments.substeps;
+      } else {
+        // The fewest substeps (of one sweep) that keep every structural edge within 5 % at every frame.
+        std::vector<std::pair<int, double>> tried;
+        for (int substeps : kSubstepChoices) {
+          solver.substeps = substeps;
+          const bench::Measurement probe = bench::measureWorld(bench::hang2(n, solver), arguments.frames, 1, 1);
+          tried.emplace_back(substeps, probe.diverged ? INFINITY : probe.strainMaxRun);
+          if (!arguments.quiet) {
+            std::printf("hang2 %d: %d substeps: worst strain %.2f %%\n", n, substeps, 100.0 * tried.back().second);
+            std::fflush(stdout);
+          }
+          if (tried.back().second <= kStrainTarget) break;
+        }
+        searches.emplace_back(n, tried);
+      }
+      const sim::WorldSettings world = bench::hang2(n, solver);
+      for (int t : arguments.threads) {
+        rows.push_back({"hang2", n, bench::measureWorld(world, arguments.frames, t, arguments.repeats)});
+        progress(rows.back());
+      }
+      for (int it : arguments.naiveIterations) {
+        rows.push_back({"hang2", n, bench::measureNaive(world, arguments.frames, it, arguments.repeats)});
+        progress(rows.back());
+      }
+    }
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+      for (int t : arguments.threads) {
+        rows.push_back(
+            {scenes[k].name, 0, bench::measureWorld(scenes[k].world, arguments.frames, t, arguments.repeats)});
+        progress(rows.back());
+      }
+    }
+
+    std::ostringstream csv;
+    csv << "scene,n,particles,solver,threads,substeps,iterations,ms_per_frame,ms_per_frame_min,projections_per_s,"
+           "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle\n";
+    for (const Row& row : rows) {
+      const bench::Measurement& m = row.m;
+      csv << row.scene << ',' << row.n << ',' << m.particles << ',' << m.solver << ',' << m.threads << ',' << m.substeps
+          << ',' << m.iterations << ',' << m.msPerFrame << ',' << m.msPerFrameMin << ',' << m.projectionsPerSecond
+          << ',' << m.strainMaxEnd << ',' << m.strainMeanEnd << ',' << m.strainMaxRun << ',' << (m.diverged ? 1 : 0)
+          << ',' << m.bytes << ','
+          << static_cast<double>(m.bytes) / static_cast<double>(std::max<std::size_t>(m.particles, 1)) << '\n';
+    }
+
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double peakMiB = static_cast<double>(usage.ru_maxrss) / 1024.0;
+
+    std::ostringstream report;
+    report << "# Performance\n\n"
+           << "Generated by `tools/bench` (`drape-cli bench --report docs/performance.md --out-dir "
+              "docs/performance`); do not edit by hand.\n\n"
+           << "Machine: " << cpuName() << ", " << std::thread::hardware_concurrency()
+           << " hardware threads. Build: " << kBuildDescription << ". " << arguments.frames
+           << " frames of 1/60 s per run, the median of up to " << arguments.repeats
+           << " timed runs (wall time of the steps alone).\n\n"
+           << "## hang2\n\n"
+           << "An N x N sheet, 1 m square in the x-z plane, 1 kg, pinned at two corners, structural + shear + bend "
+              "(all rigid), gravity, dt = 1/60 s: it falls and swings from its two corners. Drape solves it with "
+              "tethers to the pins and each row and column of stretch constraints solved at once (`lines`), in "
+              "substeps of one sweep (how many for each N is below). The naive baseline is the textbook loop: an array "
+              "of particle structs, "
+              "Verlet, then Gauss-Seidel sweeps over every constraint in lattice order (`engine/bench/src/naive.cpp`). "
+              "Strain is the structural constraints' |x_b - x_a| / r - 1: max and mean at the end, and the worst "
+              "after any frame.\n\n"
+           << "| N | particles | solver | threads | substeps x sweeps | ms / frame | projections / s | strain max "
+              "(end) | mean (end) | worst (any frame) | bytes / particle |\n"
+           << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const Row& row : rows) {
+      if (row.n == 0) continue;
+      const bench::Measurement& m = row.m;
+      report << "| " << row.n << " | " << m.particles << " | " << m.solver << " | " << m.threads << " | " << m.substeps
+             << " x " << m.iterations << " | " << format("%.3f", m.msPerFrame) << " | "
+             << format("%.3g", m.projectionsPerSecond) << " | " << (m.diverged ? "diverged" : percent(m.strainMaxEnd))
+             << " | " << percent(m.strainMeanEnd) << " | " << percent(m.strainMaxRun) << " | "
+             << format("%.0f", static_cast<double>(m.bytes) / static_cast<double>(m.particles)) << " |\n";
+    }
+    if (!searches.empty()) {
+      report << "\nDrape's substeps for each N are the fewest (of ";
+      for (std::size_t i = 0; i < std::size(kSubstepChoices); ++i) report << (i ? ", " : "") << kSubstepChoices[i];
+      report << ") that keep every structural edge within " << percent(kStrainTarget)
+             << " of its rest length after every frame, one sweep each; the runs tried:\n\n";
+      for (const auto& [n, tried] : searches) {
+        report << "- N = " << n << ":";
+        for (const auto& [substeps, worst] : tried)
+          report << " " << substeps << " substeps, worst " << percent(worst) << ";";
+        report << "\n";
+      }
+    }
+    report << "\n![time per frame against particle count](performance/performance.png)\n\n"
+           << "## Against the naive baseline\n\n"
+           << "At equal strain: the cheapest naive run that ends with no more strain than Drape on one thread, "
+              "divided by Drape's time. Where no naive run gets there, the costliest one is used and the ratio is a "
+              "lower bound (more sweeps cost more and strain less).\n\n"
+           << "| N | Drape, 1 thread | naive run compared | ratio |\n|---|---|---|---|\n";
+    for (int n : arguments.sizes) {
+      const Row* drape = nullptr;
+      std::vector<const Row*> naive;
+      for (const Row& row : rows) {
+        if (row.n != n) continue;
+        if (row.m.solver == "drape" && row.m.threads == 1) drape = &row;
+        if (row.m.solver == "naive") naive.push_back(&row);
+      }
+      if (!drape || naive.empty()) continue;
+      const Row* match = nullptr;
+      for (const Row* candidate : naive) {
+        const bool reaches = !candidate->m.diverged && candidate->m.strainMaxEnd <= drape->m.strainMaxEnd;
+        if (reaches && (!match || candidate->m.msPerFrame < match->m.msPerFrame)) match = candidate;
+      }
+      const bool bound = match == nullptr;
+      if (bound) {
+        match = *std::max_element(naive.begin(), naive.end(),
+                                  [](const Row* a, const Row* b) { return a->m.msPerFrame < b->m.msPerFrame; });
+      }
+      report << "| " << n << " | " << format("%.3f ms", drape->m.msPerFrame) << ", strain "
+             << percent(drape->m.strainMaxEnd) << " | " << match->m.iterations
+             << " sweeps: " << format("%.3f ms", match->m.msPerFrame) << ", strain "
+             << (match->m.diverged ? "diverged" : percent(match->m.strainMaxEnd)) << " | " << (bound ? "≥ " : "")
+             << format("%.0fx", match->m.msPerFrame / drape->m.msPerFrame) << " |\n";
+    }
+    report << "\n## Where the time goes\n\n"
+           << "Milliseconds per frame in each stage of the pipeline; a stage a scene does not need is not in its "
+              "pipeline at all. `(step)` is the whole step: what it has beyond the stages is the pipeline's own "
+              "cost.\n\n";
+    for (const Row& row : rows) {
+      const bool lastHang2 = row.n == arguments.sizes.back() && row.m.solver == "drape";
+      if (!(row.n == 0 || lastHang2)) continue;
+      report << "- " << (row.n > 0 ? "hang2 " + std::to_string(row.n) : row.scene) << ", " << row.m.threads
+             << (row.m.threads == 1 ? " thread" : " threads") << " (" << row.m.particles << " particles, strain max "
+             << percent(row.m.strainMaxEnd) << ", "
+             << format("%.0f", static_cast<double>(row.m.bytes) / static_cast<double>(row.m.particles))
+             << " bytes/particle):";
+      for (const auto& [stage, ms] : row.m.stageMs) report << " " << stage << " " << format("%.3f", ms) << ";";
+      report << "\n";
+    }
+    report << "\nPeak resident memory of the whole benchmark process: " << format("%.0f", peakMiB) << " MiB.\n";
+
+    std::error_code error;
+    std::filesystem::create_directories(directory, error);
+    if (error) throw scene::InputError(directory.string() + ": cannot create the folder: " + error.message());
+    scene::writeFilesAtomically(
+        {{directory / "performance.csv", csv.str()},
+         {directory / "performance.dat", plotData(rows, arguments.threads, arguments.naiveIterations)},
+         {directory / "performance.gp", plotScript(directory, arguments.threads, arguments.naiveIterations)}});
+    const std::string command = "gnuplot '" + (directory / "performance.gp").string() + "'";
+    if (std::system(command.c_str()) != 0) {
+      throw scene::InputError("gnuplot could not draw " + (directory / "performance.png").string() +
+                              " (is gnuplot installed? tools/setup installs it)");
+    }
+    if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
+    if (!arguments.quiet) {
+      std::printf("wrote %s/performance.csv, performance.png%s%s\n", directory.c_str(), arguments.report ? " and " : "",
+                  arguments.report ? arguments.report->c_str() : "");
+    }
+    return kExitOk;
+  } catch (const scene::InputError& error) {
+    return badInput(error.what());
+  }
+}
+
+}  // namespace drape::cli
