@@ -325,7 +325,7 @@ TEST_F(Cli, StudyReportsErrorAgainstTimeWithAParetoFront) {
   std::istringstream csv(read(folder / "accuracy.csv"));
   std::string line;
   std::getline(csv, line);
-  EXPECT_EQ(line, "config,cpu_s_per_simulated_s,strain_max,strain_mean,rms_error_m,pareto");
+  EXPECT_EQ(line, "config,cpu_s_per_simulated_s,strain_max,strain_mean,rms_error_m,pareto,chosen");
   double coarse = 0.0, fine = 0.0;
   while (std::getline(csv, line)) {
     const std::size_t comma = line.find(',', line.find('"', 1));
@@ -339,6 +339,39 @@ TEST_F(Cli, StudyReportsErrorAgainstTimeWithAParetoFront) {
   EXPECT_LT(fine, coarse);  // four substeps land nearer the reference than one
   EXPECT_NE(read(report).find("| rk4 |"), std::string::npos);
   expectOneLineError(run("study chain --sweep solver.substeps"), 2, "--sweep solver.substeps: expected path=value1");
+}
+
+TEST_F(Cli, StudyChoosesTheCheapestRunWithinTheStrainBound) {
+  // On the chain one substep of two sweeps stretches it by far more than 5 % on its way
+  // down, eight substeps do not.
+  const fs::path folder = file("choice"), report = file("choice.md");
+  const Result result =
+      run("study chain --time 1 --repeats 1 --no-reference --choose 0.05 --sweep solver.substeps=1,8 --sweep "
+          "solver.iterations=2 --quiet --out-dir '" +
+          folder.string() + "' --report '" + report.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::istringstream csv(read(folder / "accuracy.csv"));
+  std::string line;
+  std::getline(csv, line);
+  int chosenCount = 0;
+  while (std::getline(csv, line)) {
+    const std::size_t comma = line.find(',', line.find('"', 1));
+    double time, strainMax;
+    int chosen = 0;
+    ASSERT_EQ(std::sscanf(line.c_str() + comma + 1, "%lf,%lf,%*f,%*[^,],%*d,%d", &time, &strainMax, &chosen), 3)
+        << line;
+    if (line.find("substeps=1 ") != std::string::npos) {
+      EXPECT_GT(strainMax, 0.05);
+      EXPECT_EQ(chosen, 0);
+    } else {
+      EXPECT_LE(strainMax, 0.05);
+      EXPECT_EQ(chosen, 1);
+    }
+    chosenCount += chosen;
+  }
+  EXPECT_EQ(chosenCount, 1);
+  EXPECT_NE(read(report).find("**Chosen** (the cheapest whose worst strain stays within 5.00 %): substeps=8"),
+            std::string::npos);
 }
 
 TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {

@@ -106,6 +106,7 @@ int bench(const BenchArguments& input) {
       arguments.repeats = 1;
       arguments.naiveIterations = {10};
     }
+    std::erase(arguments.naiveIterations, 0);  // 0: no baseline
     for (int n : arguments.sizes) {
       if (n < 2 || n > 1024) throw scene::InputError("--sizes: " + std::to_string(n) + " is not between 2 and 1024");
     }

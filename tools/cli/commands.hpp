@@ -59,6 +59,9 @@ struct StudyArguments {
   std::optional<double> seconds;
   std::vector<std::string> sweeps;  // path=v1,v2,...
   int repeats = 3;
+  std::optional<std::string> gesture;  // played in every run
+  std::optional<double> choose;        // mark the cheapest run whose worst strain is within this
+  bool noReference = false;            // skip the reference runs (no trajectory error)
   std::string outDir = "accuracy";
   std::optional<std::string> report;
   bool quiet = false;

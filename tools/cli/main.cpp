@@ -100,6 +100,13 @@ int main(int argc, char** argv) {
   studyCommand->add_option("--sweep", studyArguments.sweeps, "path=v1,v2,... (repeatable: every combination runs)");
   studyCommand->add_option("--repeats", studyArguments.repeats, "Timed runs per configuration (median)")
       ->check(CLI::Range(1, 100));
+  studyCommand->add_option("--gesture", studyArguments.gesture, "Play this gesture script in every run");
+  studyCommand
+      ->add_option("--choose", studyArguments.choose,
+                   "Mark the cheapest configuration whose worst strain stays within this (0.05 = 5 %)")
+      ->check(CLI::Range(0.0, 10.0));
+  studyCommand->add_flag("--no-reference", studyArguments.noReference,
+                         "No reference runs: compare time with worst strain only (much faster)");
   addReportOptions(studyCommand, studyArguments.outDir, studyArguments.report, studyArguments.quiet);
 
   BenchArguments benchArguments;
@@ -113,9 +120,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   benchCommand
       ->add_option("--naive-iterations", benchArguments.naiveIterations,
-                   "The naive baseline's sweeps per frame (default 10,200; empty: no baseline)")
+                   "The naive baseline's sweeps per frame (default 10,200; 0: no baseline)")
       ->delimiter(',')
-      ->check(CLI::Range(1, 100000));
+      ->check(CLI::Range(0, 100000));
   benchCommand->add_option("--scenes", benchArguments.scenes, "More scenes to time (default drape-sphere,hang2-tear)")
       ->delimiter(',');
   benchCommand->add_option("--frames", benchArguments.frames, "Frames per run (default 120)")

@@ -19,6 +19,7 @@
 #include "drape/analysis/analytic.hpp"
 #include "drape/analysis/convergence.hpp"
 #include "drape/scene/error.hpp"
+#include "drape/scene/gesture.hpp"
 #include "drape/scene/output.hpp"
 #include "drape/sim/metrics.hpp"
 
@@ -53,8 +54,9 @@ struct Trajectory {
   bool diverged = false;
 };
 
-Trajectory simulate(const scene::Scene& scene, std::int64_t steps) {
-  sim::World world = makeWorld(scene);
+Trajectory simulate(const scene::Scene& scene, std::int64_t steps, const std::optional<std::string>& gesture) {
+  Playback playback(scene, gesture);
+  sim::World& world = playback.world();
   Trajectory t;
   const auto sample = [&] {
     std::vector<sim::Vec3> all;
@@ -66,7 +68,7 @@ Trajectory simulate(const scene::Scene& scene, std::int64_t steps) {
   double stepping = 0.0, strainSum = 0.0;
   for (std::int64_t i = 1; i <= steps; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    const sim::StepStatus status = world.step();
+    const sim::StepStatus status = playback.step();
     stepping += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (status == sim::StepStatus::diverged) {
       t.diverged = true;
@@ -86,7 +88,8 @@ double rmsDistance(const Trajectory& a, const Trajectory& b) {
   double sum = 0.0;
   std::size_t count = 0;
   for (std::size_t s = 0; s < std::min(a.samples.size(), b.samples.size()); ++s) {
-    for (std::size_t i = 0; i < a.samples[s].size(); ++i) {
+    // A tear or a drawn cloth can make the runs' particle counts differ: the common ones count.
+    for (std::size_t i = 0; i < std::min(a.samples[s].size(), b.samples[s].size()); ++i) {
       const sim::Vec3 d = a.samples[s][i] - b.samples[s][i];
       sum += glm::dot(d, d);
       ++count;
@@ -109,7 +112,9 @@ int study(const StudyArguments& arguments) {
     std::vector<Sweep> sweeps;
     for (const std::string& text : arguments.sweeps) sweeps.push_back(parseSweep(text));
     const scene::Scene base = loadScene(arguments.input);
-    const std::int64_t steps = stepCount(base, arguments.steps, arguments.seconds);
+    std::optional<interact::GestureScript> script;
+    if (arguments.gesture) script = scene::loadGesture(*arguments.gesture);
+    const std::int64_t steps = stepCount(base, arguments.steps, arguments.seconds, script ? &*script : nullptr);
     if (base.world.solver.model != sim::Model::position && arguments.sweeps.empty()) {
       throw scene::InputError(base.source + ": study refines substeps and iterations; give --sweep values to compare");
     }
@@ -121,10 +126,14 @@ int study(const StudyArguments& arguments) {
 
     // The reference: 8x the substeps and 4x the iterations; refining once more (16x, 8x) shows
     // how far the reference itself is from converged.
-    const Trajectory reference = simulate(refined(base, 8, 4), steps);
-    const Trajectory finer = simulate(refined(base, 16, 8), steps);
-    if (reference.diverged || finer.diverged) throw scene::InputError(base.source + ": the reference run diverged");
-    const double referenceUncertainty = rmsDistance(reference, finer);
+    Trajectory reference, finer;
+    double referenceUncertainty = NAN;
+    if (!arguments.noReference) {
+      reference = simulate(refined(base, 8, 4), steps, arguments.gesture);
+      finer = simulate(refined(base, 16, 8), steps, arguments.gesture);
+      if (reference.diverged || finer.diverged) throw scene::InputError(base.source + ": the reference run diverged");
+      referenceUncertainty = rmsDistance(reference, finer);
+    }
 
     struct Row {
       std::string label;
@@ -146,39 +155,54 @@ int study(const StudyArguments& arguments) {
       std::vector<double> times;
       Trajectory run;
       for (int r = 0; r < arguments.repeats; ++r) {
-        run = simulate(configured, steps);
+        run = simulate(configured, steps, arguments.gesture);
         times.push_back(run.cpuSecondsPerSimulatedSecond);
       }
       std::sort(times.begin(), times.end());
       rows.push_back({label.empty() ? "scene as written" : label, times[times.size() / 2], run.strainMax,
-                      run.strainMean, run.diverged ? NAN : rmsDistance(run, reference), run.diverged});
+                      run.strainMean, run.diverged || arguments.noReference ? NAN : rmsDistance(run, reference),
+                      run.diverged});
       std::size_t s = 0;
       while (s < sweeps.size() && ++index[s] == sweeps[s].values.size()) index[s++] = 0;
       if (s == sweeps.size()) break;
     }
     // Pareto front: no other run is both faster and more accurate.
+    // Without a reference the accuracy compared is the worst strain.
+    const auto inaccuracy = [&](const Row& row) { return arguments.noReference ? row.strainMax : row.error; };
     for (Row& row : rows) {
       row.pareto = !row.diverged && std::none_of(rows.begin(), rows.end(), [&](const Row& other) {
-        return !other.diverged && &other != &row && other.time <= row.time && other.error <= row.error &&
-               (other.time < row.time || other.error < row.error);
+        return !other.diverged && &other != &row && other.time <= row.time && inaccuracy(other) <= inaccuracy(row) &&
+               (other.time < row.time || inaccuracy(other) < inaccuracy(row));
       });
     }
 
+    // With --choose: the cheapest run whose worst strain stays within the bound.
+    const Row* chosen = nullptr;
+    if (arguments.choose) {
+      for (const Row& row : rows) {
+        if (!row.diverged && row.strainMax <= *arguments.choose && (!chosen || row.time < chosen->time)) chosen = &row;
+      }
+    }
+
     std::ostringstream csv, report, gp;
-    csv << "config,cpu_s_per_simulated_s,strain_max,strain_mean,rms_error_m,pareto\n";
+    csv << "config,cpu_s_per_simulated_s,strain_max,strain_mean,rms_error_m,pareto,chosen\n";
     for (const Row& r : rows) {
       csv << '"' << r.label << "\"," << r.time << ',' << r.strainMax << ',' << r.strainMean << ',' << r.error << ','
-          << (r.pareto ? 1 : 0) << '\n';
+          << (r.pareto ? 1 : 0) << ',' << (&r == chosen ? 1 : 0) << '\n';
     }
     gp << "set terminal pngcairo size 900,600 font ',10'\nset output '" << (directory / "accuracy.png").string()
        << "'\nset datafile separator ','\nset logscale xy\nset key top right\n"
-       << "set xlabel 'CPU time per simulated second (s)'\nset ylabel 'RMS distance from the reference (m)'\n"
-       << "set title '" << base.name << ": error against run time (Pareto front joined)'\n"
-       << "plot '" << (directory / "accuracy.csv").string()
-       << "' skip 1 using 2:5 with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'configurations', \\\n"
-       << "     '' skip 1 using 2:($6 == 1 ? $5 : 1/0) smooth unique with linespoints pt 7 ps 1.6 lw 2 lc rgb "
+       << "set xlabel 'CPU time per simulated second (s)'\nset ylabel '"
+       << (arguments.noReference ? "worst structural strain over the run" : "RMS distance from the reference (m)")
+       << "'\n"
+       << "set title '" << base.name << ": error against run time (Pareto front joined)'\n";
+    const int y = arguments.noReference ? 3 : 5;
+    gp << "plot '" << (directory / "accuracy.csv").string() << "' skip 1 using 2:" << y
+       << " with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'configurations', \\\n"
+       << "     '' skip 1 using 2:($6 == 1 ? $" << y
+       << " : 1/0) smooth unique with linespoints pt 7 ps 1.6 lw 2 lc rgb "
           "'#d62728' title 'Pareto front', \\\n"
-       << "     '' skip 1 using 2:5:1 with labels offset 0,1 font ',7' notitle\n";
+       << "     '' skip 1 using 2:" << y << ":1 with labels offset 0,1 font ',7' notitle\n";
 
     report << "# Error against run time: " << base.name << "\n\n"
            << "Generated by `drape-cli study` (the command line is below); do not edit.\n\n"
@@ -189,8 +213,32 @@ int study(const StudyArguments& arguments) {
            << "every " << kSampleEvery
            << " steps, from a reference run at 8x the substeps and 4x the iterations of the "
            << "scene as written; refining the reference once more (16x, 8x) moves it by " << referenceUncertainty
-           << " m RMS, the floor below which errors here mean nothing.\n\n"
-           << "![error against run time](accuracy/accuracy.png)\n\n"
+           << " m RMS, the floor below which errors here mean nothing"
+           << (arguments.noReference
+                   ? " (here: no reference run, --no-reference; the front is over time and worst strain)"
+                   : "")
+           << ".\n\n";
+    if (arguments.gesture) report << "Every run plays the gesture script `" << *arguments.gesture << "`.\n\n";
+    if (arguments.choose) {
+      char line[512];
+      if (chosen) {
+        std::snprintf(line, sizeof line,
+                      "**Chosen** (the cheapest whose worst strain stays within %.2f %%): %s, %.4f s/s, worst strain "
+                      "%.2f %%.\n\n",
+                      100.0 * *arguments.choose, chosen->label.c_str(), chosen->time, 100.0 * chosen->strainMax);
+      } else {
+        std::snprintf(line, sizeof line, "**Chosen**: none; no configuration kept the worst strain within %.2f %%.\n\n",
+                      100.0 * *arguments.choose);
+      }
+      report << line;
+    }
+    // The picture, relative to where the report goes.
+    fs::path picture = directory / "accuracy.png";
+    if (arguments.report) {
+      const fs::path from = fs::absolute(fs::path(*arguments.report)).parent_path();
+      picture = fs::absolute(picture).lexically_relative(from);
+    }
+    report << "![error against run time](" << picture.string() << ")\n\n"
            << "| configuration | time (s/s) | worst strain | mean strain | error (m) | Pareto "
               "|\n|---|---|---|---|---|---|\n";
     for (const Row& r : rows) {
