@@ -222,6 +222,63 @@ int bench(const BenchArguments& input) {
         report << "\n";
       }
     }
+    // The targets, as measured here.
+    const auto find = [&](int n, const char* solver, int threads) -> const Row* {
+      for (const Row& row : rows) {
+        if (row.n == n && row.m.solver == solver && (std::string(solver) != "drape" || row.m.threads == threads))
+          return &row;
+      }
+      return nullptr;
+    };
+    report << "\n### Against the targets\n\n| target | measured | met |\n|---|---|---|\n";
+    const auto target = [&](const std::string& what, const std::string& measured, bool met) {
+      report << "| " << what << " | " << measured << " | " << (met ? "yes" : "**no**") << " |\n";
+    };
+    if (const Row* r = find(128, "drape", 1)) {
+      target("hang2 128, strain <= 5 % at the end, no blow-up: <= 4 ms per frame on one core",
+             format("%.2f ms", r->m.msPerFrame) + ", strain " + percent(r->m.strainMaxEnd) + " (worst " +
+                 percent(r->m.strainMaxRun) + ")",
+             r->m.msPerFrame <= 4.0 && r->m.strainMaxEnd <= kStrainTarget && !r->m.diverged);
+    }
+    if (const Row* r = find(256, "drape", 2)) {
+      target("hang2 256 at <= 5 % strain: <= 8 ms per frame on 2 threads",
+             format("%.2f ms", r->m.msPerFrame) + ", strain " + percent(r->m.strainMaxEnd),
+             r->m.msPerFrame <= 8.0 && r->m.strainMaxEnd <= kStrainTarget && !r->m.diverged);
+    }
+    for (int n : arguments.sizes) {
+      const Row* r = find(n, "drape", arguments.threads.front());
+      if (!r) continue;
+      const double perParticle = static_cast<double>(r->m.bytes) / static_cast<double>(r->m.particles);
+      target("hang2 " + std::to_string(n) + ": <= 200 bytes per particle, constraints included",
+             format("%.0f bytes", perParticle), perParticle <= 200.0);
+    }
+    if (arguments.sizes.size() >= 2) {
+      const Row* small = find(arguments.sizes.front(), "drape", 1);
+      const Row* large = find(arguments.sizes.back(), "drape", 1);
+      if (small && large) {
+        const double growth = (large->m.msPerFrame / small->m.msPerFrame) /
+                              (static_cast<double>(large->m.particles) / static_cast<double>(small->m.particles));
+        target("cost grows linearly with particles (time per particle, largest over smallest N)",
+               format("%.2fx", growth) + " (substeps " + std::to_string(small->m.substeps) + " -> " +
+                   std::to_string(large->m.substeps) + ")",
+               growth <= 1.5);
+      }
+    }
+    bool same = true;
+    for (const Row& a : rows) {
+      for (const Row& b : rows) {
+        if (a.n > 0 && a.n == b.n && a.m.solver == "drape" && b.m.solver == "drape") {
+          same = same && a.m.strainMaxEnd == b.m.strainMaxEnd && a.m.strainMeanEnd == b.m.strainMeanEnd &&
+                 a.m.strainMaxRun == b.m.strainMaxRun;
+        }
+      }
+    }
+    target("1 and N threads give the same result bit for bit",
+           std::string(same ? "the same strains, to the last bit, at every thread count above"
+                            : "strains differ between thread counts") +
+               "; sim_tests FastSweep.* compare every position (1, 2, 3, 5 threads, with tearing and XPBD)",
+           same);
+    report << "\nThe ratio to the naive baseline (>= 50x at equal strain) is in the next section.\n";
     report << "\n![time per frame against particle count](performance/performance.png)\n\n"
            << "## Against the naive baseline\n\n"
            << "At equal strain: the cheapest naive run that ends with no more strain than Drape on one thread, "
@@ -265,8 +322,25 @@ int bench(const BenchArguments& input) {
              << percent(row.m.strainMaxEnd) << ", "
              << format("%.0f", static_cast<double>(row.m.bytes) / static_cast<double>(row.m.particles))
              << " bytes/particle):";
-      for (const auto& [stage, ms] : row.m.stageMs) report << " " << stage << " " << format("%.3f", ms) << ";";
-      report << "\n";
+      double stages = 0.0, step = 0.0;
+      for (const auto& [stage, ms] : row.m.stageMs) {
+        report << " " << stage << " " << format("%.3f", ms) << ";";
+        (stage == "(step)" ? step : stages) += ms;
+      }
+      report << " outside the stages " << format("%.3f", step - stages) << " ms ("
+             << format("%.1f", step > 0.0 ? 100.0 * (step - stages) / step : 0.0) << " %)\n";
+    }
+    for (const Row& row : rows) {
+      if (!(row.n == arguments.sizes.back() && row.m.solver == "drape" && row.m.threads == arguments.threads.front())) {
+        continue;
+      }
+      report << "\nBytes per particle of hang2 " << row.n << ", by what they are for:";
+      for (const auto& [what, count] : row.m.bytesBy) {
+        report << " " << what << " "
+               << format("%.1f", static_cast<double>(count) / static_cast<double>(row.m.particles)) << ";";
+      }
+      report << " total " << format("%.1f", static_cast<double>(row.m.bytes) / static_cast<double>(row.m.particles))
+             << ".\n";
     }
     report << "\nPeak resident memory of the whole benchmark process: " << format("%.0f", peakMiB) << " MiB.\n";
 

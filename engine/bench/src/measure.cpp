@@ -57,7 +57,16 @@ Measurement measureWorld(const sim::WorldSettings& settings, int frames, int thr
     const sim::StrainStats end = sim::structuralStrain(world);
     m.strainMaxEnd = end.max;
     m.strainMeanEnd = end.mean;
-    m.bytes = world.memoryBytes();
+    const sim::MemoryUse use = world.memoryUse();
+    m.bytes = use.total();
+    m.bytesBy = {{"state", use.state},
+                 {"rest positions and triangles", use.rest},
+                 {"constraints", use.constraints},
+                 {"tethers", use.tethers},
+                 {"lines", use.lines},
+                 {"guard's copy", use.guard},
+                 {"topology", use.topology},
+                 {"scratch", use.solver}};
     for (const sim::Cloth& cloth : world.cloths()) {
       m.particles += cloth.state.position.size();
       for (sim::ConstraintKind kind : sim::kConstraintKinds) {

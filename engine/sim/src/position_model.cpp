@@ -128,16 +128,31 @@ bool inBall(Vec3 x, Vec3 c, Real r) {
 // is never empty for tethers: the rest shape lies in it). Projecting onto one ball and then the
 // other instead converges slowly where the balls barely overlap, as they do along an edge between
 // two pins (the radii add up to the pins' distance): that edge then sags.
-Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb) {
+// The line through two pins: consecutive particles mostly share their pins, so it is worked out
+// once per pair met.
+struct PinAxis {
+  ParticleIndex a = ~ParticleIndex{0}, b = ~ParticleIndex{0};
+  Vec3 n{0.0};  // unit, from a to b
+  Real distance = 0.0;
+  void update(ParticleIndex pinA, ParticleIndex pinB, Vec3 xa, Vec3 xb) {
+    if (pinA == a && pinB == b) return;
+    a = pinA;
+    b = pinB;
+    const Vec3 axis = xb - xa;
+    distance = glm::length(axis);
+    n = distance > 0.0 ? axis / distance : Vec3{0.0};
+  }
+};
+
+Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
   const Vec3 toA = intoBall(x, a, ra);
   if (inBall(toA, b, rb)) return toA;
   const Vec3 toB = intoBall(x, b, rb);
   if (inBall(toB, a, ra)) return toB;
   // On both spheres: the circle where they meet, centre a + n t, radius rho, in the plane normal to n.
-  const Vec3 axis = b - a;
-  const Real distance = glm::length(axis);
+  const Real distance = axis.distance;
   if (!(distance > 0.0)) return toA;
-  const Vec3 n = axis / distance;
+  const Vec3 n = axis.n;
   const Real t = std::clamp((distance * distance + ra * ra - rb * rb) / (2.0 * distance), 0.0, ra);
   const Real rho = std::sqrt(std::max(ra * ra - t * t, 0.0));
   const Vec3 centre = a + n * t;
@@ -155,13 +170,15 @@ void projectTethers(ParticleState& s, const std::vector<SolverScratch::Tether>& 
   const auto sameParticle = [&](std::size_t k) { return tethers[k].particle == tethers[k - 1].particle; };
   while (begin > 0 && begin < tethers.size() && sameParticle(begin)) ++begin;
   while (end > 0 && end < tethers.size() && sameParticle(end)) ++end;
+  PinAxis axis;  // pins do not move while tethers are projected
   for (std::size_t k = begin; k < end;) {
     const ParticleIndex particle = tethers[k].particle;
     std::size_t last = k + 1;
     while (last < tethers.size() && tethers[last].particle == particle) ++last;
     if (last - k == 2 && tetherActive(s, tethers[k]) && tetherActive(s, tethers[k + 1])) {
-      s.position[particle] = intoLens(s.position[particle], s.position[tethers[k].pin], tethers[k].length,
-                                      s.position[tethers[k + 1].pin], tethers[k + 1].length);
+      const Vec3 a = s.position[tethers[k].pin], b = s.position[tethers[k + 1].pin];
+      axis.update(tethers[k].pin, tethers[k + 1].pin, a, b);
+      s.position[particle] = intoLens(s.position[particle], a, tethers[k].length, b, tethers[k + 1].length, axis);
     } else {
       for (std::size_t j = k; j < last; ++j) {
         const SolverScratch::Tether& t = tethers[j];

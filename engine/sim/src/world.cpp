@@ -323,34 +323,38 @@ std::size_t bytes(const std::array<std::vector<T>, N>& arrays) {
 }
 }  // namespace
 
-std::size_t World::memoryBytes() const {
-  std::size_t total = 0;
+MemoryUse World::memoryUse() const {
+  MemoryUse m;
   for (const Cloth& cloth : cloths_) {
-    total += bytes(cloth.rest.restPositions) + bytes(cloth.rest.triangles) + bytes(cloth.rest.constraints);
+    m.rest += bytes(cloth.rest.restPositions) + bytes(cloth.rest.triangles);
+    m.constraints += bytes(cloth.rest.constraints);
     const ParticleState& s = cloth.state;
-    total += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) + bytes(s.mass) +
-             bytes(s.pinned);
+    m.state += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) +
+               bytes(s.mass) + bytes(s.pinned);
     const Topology& t = cloth.topology;
-    total += bytes(t.neighbour) + bytes(t.triangleArea) + bytes(t.templates) + bytes(t.source);
-    total += bytes(cloth.piece);
+    m.topology +=
+        bytes(t.neighbour) + bytes(t.triangleArea) + bytes(t.templates) + bytes(t.source) + bytes(cloth.piece);
   }
   for (const SolverScratch& s : scratch_) {
-    total += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
-             bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
-             bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.tethers) + bytes(s.looseStretch) + bytes(s.lineNormal) +
-             bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.batchStart);
+    m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
+                bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
+                bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.looseStretch) + bytes(s.lineNormal) +
+                bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.batchStart);
+    m.tethers += bytes(s.tethers);
     for (const SolverScratch::LineFamily& f : s.lines) {
-      total += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda);
+      m.lines += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda);
     }
   }
   for (const Snapshot& snapshot : lastGood_) {
-    total += bytes(snapshot.position) + bytes(snapshot.previousPosition) + bytes(snapshot.velocity);
+    m.guard += bytes(snapshot.position) + bytes(snapshot.previousPosition) + bytes(snapshot.velocity);
   }
-  for (const std::vector<std::uint8_t>& held : held_) total += bytes(held);
+  for (const std::vector<std::uint8_t>& held : held_) m.solver += bytes(held);
   const SelfCollisionScratch& h = selfCollisionScratch_;
-  total += bytes(h.owner) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
-  return total;
+  m.solver += bytes(h.owner) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
+  return m;
 }
+
+std::size_t World::memoryBytes() const { return memoryUse().total(); }
 
 std::size_t World::tetherCount() const {
   std::size_t n = 0;

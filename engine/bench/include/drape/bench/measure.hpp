@@ -28,6 +28,7 @@ struct Measurement {
   double strainMaxRun = 0.0;  // worst structural strain after any frame
   bool diverged = false;      // non-finite (naive) or stopped by the guard (drape)
   std::size_t bytes = 0;      // what the solver keeps for the cloth: state, rest data, constraints, scratch
+  std::vector<std::pair<std::string, std::size_t>> bytesBy;  // drape: the same by what it is for
   // drape: ms per frame in each pipeline stage, then "(step)": the whole step, stages and the rest
   std::vector<std::pair<std::string, double>> stageMs;
 };

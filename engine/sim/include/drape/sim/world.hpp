@@ -54,6 +54,19 @@ enum class StepStatus : std::uint8_t { ok, diverged };
 
 class Workers;
 
+// Bytes a world keeps (every array's capacity), by what they are for.
+struct MemoryUse {
+  std::size_t state = 0;        // positions, previous positions, velocities, masses, pins
+  std::size_t rest = 0;         // rest positions and triangles
+  std::size_t constraints = 0;  // stretch, shear, bend
+  std::size_t topology = 0;     // tearing's adjacency and recipes (once torn or cut), pieces
+  std::size_t tethers = 0;
+  std::size_t lines = 0;   // the fast sweep's rows and columns
+  std::size_t solver = 0;  // scratch: contacts, wind, multipliers, batches, line solves, fingers, self-collision
+  std::size_t guard = 0;   // the copy of the last good state a divergence goes back to
+  std::size_t total() const { return state + rest + constraints + topology + tethers + lines + solver + guard; }
+};
+
 inline constexpr int kMaxThreads = 64;
 
 class World {
@@ -71,6 +84,7 @@ class World {
   // Bytes the world keeps for its cloths (every array's capacity: state, rest data, constraints,
   // solver scratch, the guard's copy of the last good state).
   std::size_t memoryBytes() const;
+  MemoryUse memoryUse() const;
   std::size_t tetherCount() const;
 
   StepStatus step();
