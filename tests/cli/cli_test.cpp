@@ -346,7 +346,8 @@ TEST_F(Cli, StudyChoosesTheCheapestRunWithinTheStrainBound) {
   // down, eight substeps do not.
   const fs::path folder = file("choice"), report = file("choice.md");
   const Result result =
-      run("study chain --time 1 --repeats 1 --no-reference --choose 0.05 --sweep solver.substeps=1,8 --sweep "
+      run("study chain --set solver.lines=false --time 1 --repeats 1 --no-reference --choose 0.05 --sweep "
+          "solver.substeps=1,8 --sweep "
           "solver.iterations=2 --quiet --out-dir '" +
           folder.string() + "' --report '" + report.string() + "'");
   ASSERT_EQ(result.exitCode, 0) << result.err;
@@ -370,8 +371,8 @@ TEST_F(Cli, StudyChoosesTheCheapestRunWithinTheStrainBound) {
     chosenCount += chosen;
   }
   EXPECT_EQ(chosenCount, 1);
-  EXPECT_NE(read(report).find("**Chosen** (the cheapest whose worst strain stays within 5.00 %): substeps=8"),
-            std::string::npos);
+  EXPECT_NE(read(report).find("**Chosen** (the cheapest whose worst strain stays within 5.00 %;"), std::string::npos);
+  EXPECT_NE(read(report).find("lower strain wins): substeps=8"), std::string::npos);
 }
 
 TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {

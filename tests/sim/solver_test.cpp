@@ -67,7 +67,7 @@ TEST(Lines, AStraightStretchedChainIsExactInOneSolve) {
   lines::build(cloth, scratch, 1);
   Workers workers(1);
   ASSERT_GT(worstViolation(cloth), 0.005);
-  lines::solve(cloth, scratch, 1.0, false, 0.0, workers);
+  lines::solve(cloth, scratch, 1.0, false, 0.0, workers, nullptr);
   EXPECT_LT(worstViolation(cloth), 1e-12);
   // Particle 0 is pinned and stays; the last is back at 1 m.
   EXPECT_EQ(cloth.state.position[0], Vec3(0.0));
@@ -91,9 +91,9 @@ TEST(Lines, ABentChainConvergesQuadratically) {
   lines::build(cloth, scratch, 1);
   Workers workers(1);
   const Real before = worstViolation(cloth);
-  lines::solve(cloth, scratch, 1.0, false, 0.0, workers);
+  lines::solve(cloth, scratch, 1.0, false, 0.0, workers, nullptr);
   const Real once = worstViolation(cloth);
-  lines::solve(cloth, scratch, 1.0, false, 0.0, workers);
+  lines::solve(cloth, scratch, 1.0, false, 0.0, workers, nullptr);
   const Real twice = worstViolation(cloth);
   for (const DistanceConstraint& c : byGaussSeidel.rest.of(ConstraintKind::stretch)) {
     Vec3& a = byGaussSeidel.state.position[c.a];
@@ -346,6 +346,117 @@ TEST(FastSweep, ThreadsAreCheckedAndTheStageListStaysBare) {
   std::vector<Stage> stages;
   for (const StageTiming& t : world.profile()) stages.push_back(t.stage);
   EXPECT_EQ(stages, (std::vector<Stage>{Stage::verletIntegrate, Stage::projectConstraints, Stage::guard}));
+}
+
+TEST(Tethers, TheLensIsRightWhereAParticleRestsBeyondAPin) {
+  // Pins at (0, 0, 0) and (1, 0, 0); particle (0, 1) rests at (-0.5, 0, 0.8), beyond the first pin
+  // along their axis: the circle where its two tether spheres meet lies on that side of the pin.
+  WorldSettings settings;
+  settings.solver.tethers = true;
+  settings.solver.iterations = 1;
+  settings.gravity = Vec3{0.0};
+  ClothSettings cloth = test::chainCloth(4, 2, 1.5, 0.8, 8.0, Vec3{-0.5, 0.0, 0.0}, LatticePlane::xz, {1e-12, 0.0});
+  cloth.pins = {{1, 0, std::nullopt}, {3, 0, std::nullopt}};
+  settings.cloths.push_back(cloth);
+  const Vec3 a{0.0}, b{1.0, 0.0, 0.0}, rest{-0.5, 0.0, 0.8};
+  const Real ra = glm::length(rest - a), rb = glm::length(rest - b);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<Real> coordinate(-2.0, 2.0), unit(-1.0, 1.0);
+  for (int trial = 0; trial < 100; ++trial) {
+    World world(settings);
+    std::vector<Cloth> cloths = world.cloths();
+    const Vec3 start =
+        trial == 0 ? Vec3{-1.833, -0.044, 1.528} : Vec3{coordinate(random), coordinate(random), coordinate(random)};
+    cloths[0].state.position[4] = start;  // particle (0, 1)
+    cloths[0].state.previousPosition[4] = start;
+    world.restoreCloths(cloths);
+    world.step();
+    const Vec3 x = world.cloths()[0].state.position[4];
+    ASSERT_LE(glm::length(x - a), ra + 1e-9);
+    ASSERT_LE(glm::length(x - b), rb + 1e-9);
+    const Real distance = glm::length(x - start);
+    for (int sample = 0; sample < 2000; ++sample) {
+      const Vec3 q = a + Vec3{unit(random), unit(random), unit(random)} * ra;
+      if (glm::length(q - a) > ra || glm::length(q - b) > rb) continue;
+      ASSERT_GE(glm::length(q - start), distance - 1e-9) << "trial " << trial;
+    }
+  }
+}
+
+TEST(FastSweep, ASecondTearOfAChainBreaksTheLinkThatIsPulled) {
+  // A chain of 12 particles 10 cm apart between two pins, soft enough to be pulled past the tearing
+  // threshold. Particle 3 is pulled aside: a link at it tears. Then particle 8: a link at it must
+  // tear (the constraints, reordered into batches, keep naming the recipes they came from).
+  WorldSettings settings;
+  settings.solver.lines = true;
+  settings.solver.iterations = 1;
+  settings.gravity = Vec3{0.0};
+  settings.tearing = {true, 1.3};
+  ClothSettings cloth = test::chainCloth(12, 1, 1.1, 1.0, 1.2, Vec3{0.0}, LatticePlane::xz, {0.01, 0.0});
+  cloth.pins = {{0, 0, std::nullopt}, {11, 0, std::nullopt}};
+  settings.cloths.push_back(cloth);
+  World world(settings);
+  const auto pull = [&](ParticleIndex particle) {
+    std::vector<Cloth> cloths = world.cloths();
+    cloths[0].state.position[particle].z += 0.15;
+    cloths[0].state.previousPosition[particle] = cloths[0].state.position[particle];
+    world.restoreCloths(cloths);
+    world.step();
+  };
+  // Is the link between the particles resting at x = left and x = right still there?
+  const auto joined = [&](Real left, Real right) {
+    const Cloth& c = world.cloths()[0];
+    for (const DistanceConstraint& k : c.rest.of(ConstraintKind::stretch)) {
+      const Real xa = c.rest.restPositions[k.a].x, xb = c.rest.restPositions[k.b].x;
+      if (std::abs(std::min(xa, xb) - left) < 1e-9 && std::abs(std::max(xa, xb) - right) < 1e-9) return true;
+    }
+    return false;
+  };
+  pull(3);
+  const std::uint32_t pieces = world.cloths()[0].pieceCount;
+  ASSERT_GE(pieces, 2u);
+  EXPECT_FALSE(joined(0.2, 0.3) && joined(0.3, 0.4));
+  pull(8);
+  EXPECT_GT(world.cloths()[0].pieceCount, pieces);
+  EXPECT_FALSE(joined(0.7, 0.8) && joined(0.8, 0.9));
+  // and nothing else broke
+  for (int k = 0; k < 11; ++k) {
+    if (k == 2 || k == 3 || k == 7 || k == 8) continue;
+    EXPECT_TRUE(joined(0.1 * k, 0.1 * (k + 1))) << "link " << k;
+  }
+}
+
+TEST(FastSweep, TwoThreadsShareLinesAndParticlesAndStayBitIdentical) {
+  // Large enough that the line solves, the batches and the integration are all cut in two.
+  const WorldSettings settings = fastSheet(130, 2);
+  const std::vector<Vec3> one = positionsAfter(settings, 1, 5);
+  EXPECT_EQ(positionsAfter(settings, 2, 5), one);
+}
+
+TEST(Lines, XpbdLooseLinksKeepTheirCompliance) {
+  // A particle with three links along x: one of them cannot join a line and is projected alone.
+  // Very compliant, it must barely move, as the lines do; rigid, it would snap back to rest.
+  Cloth cloth;
+  cloth.rest.restPositions = {Vec3{0.0}, Vec3{1.0, 0.0, 0.0}, Vec3{-1.0, 0.0, 0.0}, Vec3{1.0, 0.0, 0.1}};
+  for (ParticleIndex i = 1; i <= 3; ++i) {
+    cloth.rest.constraints[0].push_back({0, i, glm::length(cloth.rest.restPositions[i])});
+  }
+  cloth.state.position = cloth.rest.restPositions;
+  for (Vec3& x : cloth.state.position) x *= 1.5;
+  cloth.state.previousPosition = cloth.state.position;
+  cloth.state.inverseMass.assign(4, 1.0);
+  cloth.state.mass.assign(4, 1.0);
+  cloth.state.pinned.assign(4, 0);
+  SolverScratch scratch;
+  lines::build(cloth, scratch, 1);
+  ASSERT_EQ(scratch.looseStretch.size(), 1u);
+  const DistanceConstraint loose = cloth.rest.constraints[0][scratch.looseStretch[0]];
+  std::vector<Real> lambda(3, 0.0);
+  Workers workers(1);
+  lines::solve(cloth, scratch, 1.0, true, 1e6, workers, lambda.data());
+  const Real length = glm::length(cloth.state.position[loose.b] - cloth.state.position[loose.a]);
+  EXPECT_GT(length, 1.45 * loose.restLength);
+  EXPECT_LT(lambda[scratch.looseStretch[0]], 0.0);  // it did pull, a little
 }
 
 }  // namespace

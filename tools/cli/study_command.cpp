@@ -115,6 +115,9 @@ int study(const StudyArguments& arguments) {
     std::optional<interact::GestureScript> script;
     if (arguments.gesture) script = scene::loadGesture(*arguments.gesture);
     const std::int64_t steps = stepCount(base, arguments.steps, arguments.seconds, script ? &*script : nullptr);
+    if (arguments.choose && !std::isfinite(*arguments.choose)) {
+      throw scene::InputError("--choose: expected a finite strain such as 0.05");
+    }
     if (base.world.solver.model != sim::Model::position && arguments.sweeps.empty()) {
       throw scene::InputError(base.source + ": study refines substeps and iterations; give --sweep values to compare");
     }
@@ -159,9 +162,10 @@ int study(const StudyArguments& arguments) {
         times.push_back(run.cpuSecondsPerSimulatedSecond);
       }
       std::sort(times.begin(), times.end());
-      rows.push_back({label.empty() ? "scene as written" : label, times[times.size() / 2], run.strainMax,
-                      run.strainMean, run.diverged || arguments.noReference ? NAN : rmsDistance(run, reference),
-                      run.diverged});
+      // A run that diverged has no time or strain worth comparing.
+      rows.push_back({label.empty() ? "scene as written" : label, run.diverged ? NAN : times[times.size() / 2],
+                      run.diverged ? NAN : run.strainMax, run.diverged ? NAN : run.strainMean,
+                      run.diverged || arguments.noReference ? NAN : rmsDistance(run, reference), run.diverged});
       std::size_t s = 0;
       while (s < sweeps.size() && ++index[s] == sweeps[s].values.size()) index[s++] = 0;
       if (s == sweeps.size()) break;
@@ -176,11 +180,18 @@ int study(const StudyArguments& arguments) {
       });
     }
 
-    // With --choose: the cheapest run whose worst strain stays within the bound.
+    // With --choose: the cheapest run whose worst strain stays within the bound. Times within 10 %
+    // of the cheapest count as equal (timing noise is about that), and among those the lower
+    // strain wins, so that the choice does not flip from one study to the next.
     const Row* chosen = nullptr;
     if (arguments.choose) {
+      const auto within = [&](const Row& row) { return !row.diverged && row.strainMax <= *arguments.choose; };
+      double cheapest = INFINITY;
       for (const Row& row : rows) {
-        if (!row.diverged && row.strainMax <= *arguments.choose && (!chosen || row.time < chosen->time)) chosen = &row;
+        if (within(row)) cheapest = std::min(cheapest, row.time);
+      }
+      for (const Row& row : rows) {
+        if (within(row) && row.time <= 1.1 * cheapest && (!chosen || row.strainMax < chosen->strainMax)) chosen = &row;
       }
     }
 
@@ -223,8 +234,8 @@ int study(const StudyArguments& arguments) {
       char line[512];
       if (chosen) {
         std::snprintf(line, sizeof line,
-                      "**Chosen** (the cheapest whose worst strain stays within %.2f %%): %s, %.4f s/s, worst strain "
-                      "%.2f %%.\n\n",
+                      "**Chosen** (the cheapest whose worst strain stays within %.2f %%; times within 10 %% count "
+                      "as equal, then the lower strain wins): %s, %.4f s/s, worst strain %.2f %%.\n\n",
                       100.0 * *arguments.choose, chosen->label.c_str(), chosen->time, 100.0 * chosen->strainMax);
       } else {
         std::snprintf(line, sizeof line, "**Chosen**: none; no configuration kept the worst strain within %.2f %%.\n\n",
@@ -291,6 +302,12 @@ int study(const StudyArguments& arguments) {
       report << line;
     }
     report << "\nCommand: `drape-cli study " << arguments.input.scene;
+    if (arguments.steps) report << " --steps " << *arguments.steps;
+    if (arguments.seconds) report << " --time " << *arguments.seconds;
+    report << " --repeats " << arguments.repeats;
+    if (arguments.gesture) report << " --gesture " << *arguments.gesture;
+    if (arguments.choose) report << " --choose " << *arguments.choose;
+    if (arguments.noReference) report << " --no-reference";
     for (const std::string& s : arguments.sweeps) report << " --sweep " << s;
     for (const std::string& s : arguments.input.overrides) report << " --set " << s;
     report << " --out-dir " << arguments.outDir << (arguments.report ? " --report " + *arguments.report : "") << "`\n";

@@ -5,7 +5,7 @@
 
 namespace drape::sim::batches {
 
-Batches colour(ClothRest& rest) {
+Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source) {
   Batches result;
   const std::size_t n = rest.restPositions.size();
   std::vector<std::uint64_t> used(n);
@@ -38,8 +38,17 @@ Batches colour(ClothRest& rest) {
     result.sequentialTail[kind] = count[kColours] != count[kColours - 1];
     sorted.resize(constraints.size());
     std::array<std::uint32_t, kColours + 1> fill = count;
-    for (std::size_t k = 0; k < constraints.size(); ++k) sorted[fill[colourOf[k]]++] = constraints[k];
+    std::vector<std::uint32_t> to(constraints.size());
+    for (std::size_t k = 0; k < constraints.size(); ++k) {
+      to[k] = fill[colourOf[k]]++;
+      sorted[to[k]] = constraints[k];
+    }
     constraints.swap(sorted);
+    if (source && (*source)[kind].size() == to.size()) {
+      std::vector<std::uint32_t> moved(to.size());
+      for (std::size_t k = 0; k < to.size(); ++k) moved[to[k]] = (*source)[kind][k];
+      (*source)[kind].swap(moved);
+    }
   }
   return result;
 }

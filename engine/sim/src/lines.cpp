@@ -189,7 +189,8 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
   scratch.lineSolution.assign(slices, 0.0);
 }
 
-void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, Workers& workers) {
+void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, Workers& workers,
+           Real* looseLambda) {
   ParticleState& s = cloth.state;
   // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
   // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
@@ -213,7 +214,11 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
   }
   const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
   for (const std::uint32_t k : scratch.looseStretch) {
-    position::projectDistance(s.position, s.inverseMass, stretch[k], stiffness);
+    if (xpbd && looseLambda) {
+      position::projectCompliant(s.position, s.inverseMass, stretch[k], alphaTilde, looseLambda[k]);
+    } else {
+      position::projectDistance(s.position, s.inverseMass, stretch[k], stiffness);
+    }
   }
 }
 

@@ -25,6 +25,9 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads);
 // `stiffness` scales each correction (position model); with `xpbd`, alphaTilde = compliance / h^2
 // enters the system and scratch lambdas accumulate.
 // The lines of a family are independent: they are shared among the workers.
-void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, Workers& workers);
+// The loose stretch constraints are projected one by one, with XPBD into `looseLambda` (indexed
+// like the cloth's stretch constraints).
+void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, Workers& workers,
+           Real* looseLambda);
 
 }  // namespace drape::sim::lines

@@ -86,8 +86,6 @@ void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inver
   position[c.b] -= wb * correction;
 }
 
-namespace {
-
 // XPBD (Macklin et al. 2016, eq. 18): with C = |x_b - x_a| - r and alpha~ = compliance / h^2,
 // dlambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~), x_a -= w_a dlambda n, x_b += w_b dlambda n.
 void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inverseMass, const DistanceConstraint& c,
@@ -105,6 +103,8 @@ void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inve
   position[c.a] -= n * (wa * deltaLambda);
   position[c.b] += n * (wb * deltaLambda);
 }
+
+namespace {
 
 bool tetherActive(const ParticleState& s, const SolverScratch::Tether& t) {
   // The anchor was let go, or a finger holds the particle (then the finger decides where it is).
@@ -153,7 +153,8 @@ Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
   const Real distance = axis.distance;
   if (!(distance > 0.0)) return toA;
   const Vec3 n = axis.n;
-  const Real t = std::clamp((distance * distance + ra * ra - rb * rb) / (2.0 * distance), 0.0, ra);
+  // Signed: negative where the particle rests beyond pin a.
+  const Real t = std::clamp((distance * distance + ra * ra - rb * rb) / (2.0 * distance), -ra, ra);
   const Real rho = std::sqrt(std::max(ra * ra - t * t, 0.0));
   const Vec3 centre = a + n * t;
   const Vec3 off = (x - centre) - n * glm::dot(x - centre, n);
@@ -272,7 +273,8 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     if (material.stiffness == 0.0) continue;
     const Real alphaTilde = material.compliance / (h * h);
     if (kind == ConstraintKind::stretch) {
-      lines::solve(cloth, scratch, solver.xpbd ? 1.0 : material.stiffness, solver.xpbd, alphaTilde, workers);
+      lines::solve(cloth, scratch, solver.xpbd ? 1.0 : material.stiffness, solver.xpbd, alphaTilde, workers,
+                   scratch.lambda[kindIndex].data());
       continue;
     }
     const DistanceConstraint* constraints = cloth.rest.of(kind).data();
@@ -288,7 +290,14 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     for (std::size_t b = 0; b + 1 < start.size(); ++b) {
       const std::size_t begin = start[b], end = start[b + 1];
       if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
-        body(begin, end);
+        // Its constraints may share particles: one after another, never four side by side.
+        for (std::size_t k = begin; k < end; ++k) {
+          if (solver.xpbd) {
+            projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
+          } else {
+            projectDistance(s.position, s.inverseMass, constraints[k], material.stiffness);
+          }
+        }
       } else {
         workers.run(end - begin, [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last); });
       }

@@ -48,6 +48,10 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
 // x_prev, conserving momentum.
 void dampConstraints(Cloth& cloth);
 
+// One constraint with XPBD: alphaTilde = compliance / h^2, `lambda` its multiplier this substep.
+void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inverseMass,
+                      const DistanceConstraint& constraint, Real alphaTilde, Real& lambda);
+
 // One constraint, exposed for tests.
 void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inverseMass,
                      const DistanceConstraint& constraint, Real stiffness);

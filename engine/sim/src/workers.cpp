@@ -37,21 +37,22 @@ Workers::~Workers() {
   for (std::thread& helper : helpers_) helper.join();
 }
 
-void Workers::run(std::size_t n, const std::function<void(std::size_t, std::size_t, int)>& f, std::size_t grain) {
+void Workers::dispatch(std::size_t n, std::size_t grain, Call call, void* task) {
   const int parts = static_cast<int>(std::min<std::size_t>(
       static_cast<std::size_t>(threads()), std::max<std::size_t>(n / std::max<std::size_t>(grain, 1), 1)));
   if (parts <= 1) {
-    f(0, n, 0);
+    call(task, 0, n, 0);
     return;
   }
-  task_ = &f;
+  call_ = call;
+  task_ = task;
   items_ = n;
   active_ = parts;
   pending_.store(static_cast<int>(helpers_.size()), std::memory_order_relaxed);
   generation_.fetch_add(1, std::memory_order_release);
   generation_.notify_all();
   const auto [begin, end] = chunk(n, parts, 0);
-  f(begin, end, 0);
+  call(task, begin, end, 0);
   for (int round = 0; pending_.load(std::memory_order_acquire) != 0; ++round) pause(round);
   task_ = nullptr;
 }
@@ -72,7 +73,7 @@ void Workers::loop(int index) {
     if (stop_.load(std::memory_order_acquire)) return;
     if (index < active_) {
       const auto [begin, end] = chunk(items_, active_, index);
-      (*task_)(begin, end, index);
+      call_(task_, begin, end, index);
     }
     pending_.fetch_sub(1, std::memory_order_acq_rel);
   }

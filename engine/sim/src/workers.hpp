@@ -10,8 +10,8 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace drape::sim {
@@ -24,13 +24,26 @@ class Workers {
   Workers& operator=(const Workers&) = delete;
 
   int threads() const { return static_cast<int>(helpers_.size()) + 1; }
-  // Below `grain` items per thread the loop runs on the caller alone.
-  void run(std::size_t n, const std::function<void(std::size_t, std::size_t, int)>& f, std::size_t grain = 512);
+  // Below `grain` items per thread the loop runs on the caller alone. `f` is called as
+  // f(begin, end, thread); it is not copied (no allocation per loop).
+  template <class F>
+  void run(std::size_t n, F&& f, std::size_t grain = 512) {
+    using Task = std::remove_reference_t<F>;
+    dispatch(
+        n, grain,
+        [](void* task, std::size_t begin, std::size_t end, int thread) {
+          (*static_cast<Task*>(task))(begin, end, thread);
+        },
+        static_cast<void*>(&f));
+  }
 
  private:
+  using Call = void (*)(void*, std::size_t, std::size_t, int);
+  void dispatch(std::size_t n, std::size_t grain, Call call, void* task);
   void loop(int index);
   std::vector<std::thread> helpers_;
-  const std::function<void(std::size_t, std::size_t, int)>* task_ = nullptr;
+  Call call_ = nullptr;
+  void* task_ = nullptr;
   std::size_t items_ = 0;
   int active_ = 1;  // threads taking part in the current loop
   std::atomic<std::uint64_t> generation_{0};

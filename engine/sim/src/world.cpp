@@ -286,7 +286,9 @@ void World::plan(std::size_t c) {
   if (scratch.planVersion == topologyVersion_) return;
   if (settings_.solver.lines) {
     // The fast sweep's batches: the constraints are put in batch order, once per topology.
-    const batches::Batches made = batches::colour(cloths_[c].rest);
+    Cloth& cloth = cloths_[c];
+    // A torn cloth's constraints each name their recipe: the names move with them.
+    const batches::Batches made = batches::colour(cloth.rest, cloth.topology.built ? &cloth.topology.source : nullptr);
     scratch.batchStart = made.start;
     scratch.sequentialTail = made.sequentialTail;
     lines::build(cloths_[c], scratch, workers_->threads());
