@@ -359,11 +359,7 @@ int bench(const BenchArguments& input) {
         {{directory / "performance.csv", csv.str()},
          {directory / "performance.dat", plotData(rows, arguments.threads, arguments.naiveIterations)},
          {directory / "performance.gp", plotScript(directory, arguments.threads, arguments.naiveIterations)}});
-    const std::string command = "gnuplot '" + (directory / "performance.gp").string() + "'";
-    if (std::system(command.c_str()) != 0) {
-      throw scene::InputError("gnuplot could not draw " + (directory / "performance.png").string() +
-                              " (is gnuplot installed? tools/setup installs it)");
-    }
+    drawWithGnuplot(directory / "performance.gp", directory / "performance.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {
       std::printf("wrote %s/performance.csv, performance.png%s%s\n", directory.c_str(), arguments.report ? " and " : "",

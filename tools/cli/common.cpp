@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include "drape/scene/error.hpp"
@@ -56,6 +57,14 @@ sim::StepStatus Playback::step() { return replay_ ? replay_->step() : world_.ste
 void Playback::printReports() const {
   if (!replay_) return;
   for (const std::string& report : replay_->reports()) std::cerr << "drape-cli: warning: " << report << "\n";
+}
+
+void drawWithGnuplot(const std::filesystem::path& script, const std::filesystem::path& picture) {
+  const std::string command = "gnuplot '" + script.string() + "'";
+  if (std::system(command.c_str()) != 0) {
+    throw scene::InputError("gnuplot could not draw " + picture.string() +
+                            " (is gnuplot installed? tools/setup installs it)");
+  }
 }
 
 int reportDivergence(const scene::Scene& scene, const sim::World& world) {

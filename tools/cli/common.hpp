@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -48,6 +49,9 @@ class Playback {
   std::unique_ptr<interact::Interaction> interaction_;
   std::unique_ptr<interact::Replay> replay_;
 };
+
+// Runs gnuplot on `script`, which draws `picture`; throws scene::InputError if it cannot.
+void drawWithGnuplot(const std::filesystem::path& script, const std::filesystem::path& picture);
 
 // Prints where the world diverged and returns kExitDiverged.
 int reportDivergence(const scene::Scene& scene, const sim::World& world);

@@ -182,11 +182,7 @@ int stability(const StabilityArguments& arguments) {
                                  {directory / "stability.csv", map.str()},
                                  {directory / "boundaries.csv", boundaries.str()},
                                  {directory / "stability.gp", plotScript(directory)}});
-    const std::string command = "gnuplot '" + (directory / "stability.gp").string() + "'";
-    if (std::system(command.c_str()) != 0) {
-      throw scene::InputError("gnuplot could not draw " + (directory / "stability.png").string() +
-                              " (is gnuplot installed? tools/setup installs it)");
-    }
+    drawWithGnuplot(directory / "stability.gp", directory / "stability.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {
       std::printf("%s", report.str().c_str());

@@ -313,11 +313,7 @@ int study(const StudyArguments& arguments) {
     report << " --out-dir " << arguments.outDir << (arguments.report ? " --report " + *arguments.report : "") << "`\n";
 
     scene::writeFilesAtomically({{directory / "accuracy.csv", csv.str()}, {directory / "accuracy.gp", gp.str()}});
-    const std::string command = "gnuplot '" + (directory / "accuracy.gp").string() + "'";
-    if (std::system(command.c_str()) != 0) {
-      throw scene::InputError("gnuplot could not draw " + (directory / "accuracy.png").string() +
-                              " (is gnuplot installed? tools/setup installs it)");
-    }
+    drawWithGnuplot(directory / "accuracy.gp", directory / "accuracy.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) std::printf("%s", report.str().c_str());
     return kExitOk;

@@ -58,25 +58,22 @@ void NaiveCloth::step() {
   }
 }
 
+double NaiveCloth::strain(std::size_t k) const {
+  const Constraint& c = constraints_[k];
+  const double length = glm::length(particles_[static_cast<std::size_t>(c.b)].position -
+                                    particles_[static_cast<std::size_t>(c.a)].position);
+  return length / c.rest - 1.0;
+}
+
 double NaiveCloth::strainMax() const {
   double worst = 0.0;
-  for (std::size_t k = 0; k < structural_; ++k) {
-    const Constraint& c = constraints_[k];
-    const double length = glm::length(particles_[static_cast<std::size_t>(c.b)].position -
-                                      particles_[static_cast<std::size_t>(c.a)].position);
-    worst = std::max(worst, length / c.rest - 1.0);
-  }
+  for (std::size_t k = 0; k < structural_; ++k) worst = std::max(worst, strain(k));
   return worst;
 }
 
 double NaiveCloth::strainMean() const {
   double sum = 0.0;
-  for (std::size_t k = 0; k < structural_; ++k) {
-    const Constraint& c = constraints_[k];
-    const double length = glm::length(particles_[static_cast<std::size_t>(c.b)].position -
-                                      particles_[static_cast<std::size_t>(c.a)].position);
-    sum += std::abs(length / c.rest - 1.0);
-  }
+  for (std::size_t k = 0; k < structural_; ++k) sum += std::abs(strain(k));
   return structural_ > 0 ? sum / static_cast<double>(structural_) : 0.0;
 }
 

@@ -43,6 +43,7 @@ class NaiveCloth {
   std::vector<sim::Vec3> pinned_;        // where each pinned particle stays
   std::vector<int> pinIndex_;
   std::size_t structural_ = 0;
+  double strain(std::size_t k) const;  // of constraint k: |x_b - x_a| / rest - 1
   sim::Vec3 gravity_;
   sim::Real dt_;
   int iterations_;
