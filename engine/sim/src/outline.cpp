@@ -293,36 +293,52 @@ std::vector<Point> simplify(const std::vector<Point>& points, double tolerance) 
   return kept;
 }
 
+// A loop's points linked in a ring, from which points are removed one at a time.
+struct Ring {
+  explicit Ring(std::size_t n) : next(n), previous(n), alive(n, 1), count(n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      next[i] = (i + 1) % n;
+      previous[i] = (i + n - 1) % n;
+    }
+  }
+  // Takes point i out: its neighbours join.
+  void unlink(std::size_t i) {
+    const std::size_t a = previous[i], c = next[i];
+    next[a] = c;
+    previous[c] = a;
+    alive[i] = 0;
+    --count;
+  }
+  // The points still in, in loop order.
+  std::vector<Point> kept(const std::vector<Point>& loop) const {
+    std::vector<Point> result;
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      if (alive[i]) result.push_back(loop[i]);
+    }
+    return result;
+  }
+  std::vector<std::size_t> next, previous;
+  std::vector<char> alive;
+  std::size_t count;
+};
+
 // Removes repeated points and points on a straight line between (or folding back onto) their neighbours.
 std::vector<Point> dropStraightPoints(const std::vector<Point>& loop) {
   const std::size_t n = loop.size();
-  std::vector<std::size_t> next(n), previous(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    next[i] = (i + 1) % n;
-    previous[i] = (i + n - 1) % n;
-  }
-  std::vector<char> alive(n, 1);
-  std::size_t count = n;
+  Ring ring(n);
   std::vector<std::size_t> work(n);
   for (std::size_t i = 0; i < n; ++i) work[i] = n - 1 - i;
-  while (!work.empty() && count >= 3) {
+  while (!work.empty() && ring.count >= 3) {
     const std::size_t i = work.back();
     work.pop_back();
-    if (!alive[i]) continue;
-    const std::size_t p = previous[i], q = next[i];
+    if (!ring.alive[i]) continue;
+    const std::size_t p = ring.previous[i], q = ring.next[i];
     if (!(loop[i] == loop[p]) && orient(loop[p], loop[i], loop[q]) != 0) continue;
-    alive[i] = 0;
-    --count;
-    next[p] = q;
-    previous[q] = p;
+    ring.unlink(i);
     work.push_back(q);
     work.push_back(p);
   }
-  std::vector<Point> kept;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (alive[i]) kept.push_back(loop[i]);
-  }
-  return count >= 3 ? kept : std::vector<Point>{};
+  return ring.count >= 3 ? ring.kept(loop) : std::vector<Point>{};
 }
 
 struct Untangled {
@@ -461,13 +477,10 @@ bool isSimple(const std::vector<Point>& loop, std::uint64_t& tests) {
 // as long as the loop stays simple and keeps three points.
 std::vector<Point> removeShortEdges(const std::vector<Point>& loop, double minLength, std::uint64_t& tests) {
   const std::size_t n = loop.size();
-  std::vector<std::size_t> next(n), previous(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    next[i] = (i + 1) % n;
-    previous[i] = (i + n - 1) % n;
-  }
-  std::vector<char> alive(n, 1);
-  std::size_t count = n;
+  Ring ring(n);
+  std::vector<std::size_t>& next = ring.next;
+  std::vector<std::size_t>& previous = ring.previous;
+  const std::vector<char>& alive = ring.alive;
   // Segment ids: segmentStart[id] = the point it starts at; it is live while that point's next is segmentEnd[id].
   std::vector<std::size_t> segmentStart, segmentEnd;
   SegmentGrid grid(kUnitsPerSpacing);
@@ -506,16 +519,13 @@ std::vector<Point> removeShortEdges(const std::vector<Point>& loop, double minLe
   };
   const auto remove = [&](std::size_t i) {
     const std::size_t a = previous[i], c = next[i];
-    next[a] = c;
-    previous[c] = a;
-    alive[i] = 0;
-    --count;
+    ring.unlink(i);
     addSegment(a, c);
   };
 
   std::vector<std::size_t> work(n);
   for (std::size_t i = 0; i < n; ++i) work[i] = n - 1 - i;
-  while (!work.empty() && count > 3) {
+  while (!work.empty() && ring.count > 3) {
     const std::size_t i = work.back();
     work.pop_back();
     if (!alive[i]) continue;
@@ -533,11 +543,7 @@ std::vector<Point> removeShortEdges(const std::vector<Point>& loop, double minLe
       break;
     }
   }
-  std::vector<Point> kept;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (alive[i]) kept.push_back(loop[i]);
-  }
-  return kept;
+  return ring.kept(loop);
 }
 
 // ----------------------------------------------------------------------------------------------------------------

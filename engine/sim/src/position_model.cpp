@@ -190,44 +190,11 @@ void projectTethers(ParticleState& s, const std::vector<SolverScratch::Tether>& 
   }
 }
 
-// Constraints [begin, end) of one kind, as projectDistance each. A batch's constraints share no
-// particle, so they are taken four at a time: gathered into lanes, their square roots and divisions
-// done side by side (the compiler turns the lane loops into vector instructions), and scattered
-// back. Every constraint's arithmetic is exactly projectDistance's.
+// Constraints [begin, end) of one kind, in order, as projectDistance each. (Taking a batch four at a
+// time into lanes for vector instructions was measured on hang2: no faster, so not kept.)
 void projectRange(ParticleState& s, const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
                   Real stiffness) {
-  constexpr std::size_t L = 4;
-  Vec3* x = s.position.data();
-  const Real* w = s.inverseMass.data();
-  std::size_t k = begin;
-  for (; k + L <= end; k += L) {
-    Real dx[L], dy[L], dz[L], wa[L], wb[L], rest[L], length2[L], length[L], factor[L];
-    for (std::size_t g = 0; g < L; ++g) {
-      const DistanceConstraint& c = constraints[k + g];
-      const Vec3 d = x[c.b] - x[c.a];
-      dx[g] = d.x;
-      dy[g] = d.y;
-      dz[g] = d.z;
-      wa[g] = w[c.a];
-      wb[g] = w[c.b];
-      rest[g] = c.restLength;
-    }
-    for (std::size_t g = 0; g < L; ++g) length2[g] = dx[g] * dx[g] + dy[g] * dy[g] + dz[g] * dz[g];
-    for (std::size_t g = 0; g < L; ++g) length[g] = std::sqrt(length2[g] > 1e-20 ? length2[g] : 1.0);
-    for (std::size_t g = 0; g < L; ++g) {
-      const Real wSum = wa[g] + wb[g];
-      factor[g] = stiffness * (length[g] - rest[g]) / (length[g] * (wSum > 0.0 ? wSum : 1.0));
-    }
-    for (std::size_t g = 0; g < L; ++g) {
-      // Coincident particles, or two that nothing moves: left alone, as projectDistance does.
-      if (wa[g] + wb[g] == 0.0 || !(length2[g] > 1e-20)) continue;
-      const DistanceConstraint& c = constraints[k + g];
-      const Vec3 correction = Vec3{dx[g], dy[g], dz[g]} * factor[g];
-      x[c.a] += wa[g] * correction;
-      x[c.b] -= wb[g] * correction;
-    }
-  }
-  for (; k < end; ++k) projectDistance(s.position, s.inverseMass, constraints[k], stiffness);
+  for (std::size_t k = begin; k < end; ++k) projectDistance(s.position, s.inverseMass, constraints[k], stiffness);
 }
 
 void projectCompliantRange(ParticleState& s, const DistanceConstraint* constraints, Real* lambda, std::size_t begin,
@@ -252,7 +219,7 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
       projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
                             constraints.size(), material.compliance / (h * h));
     } else {
-      for (const DistanceConstraint& c : constraints) projectDistance(s.position, s.inverseMass, c, material.stiffness);
+      projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
     }
   }
   if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers, 0, scratch.tethers.size());
@@ -290,14 +257,7 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     for (std::size_t b = 0; b + 1 < start.size(); ++b) {
       const std::size_t begin = start[b], end = start[b + 1];
       if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
-        // Its constraints may share particles: one after another, never four side by side.
-        for (std::size_t k = begin; k < end; ++k) {
-          if (solver.xpbd) {
-            projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
-          } else {
-            projectDistance(s.position, s.inverseMass, constraints[k], material.stiffness);
-          }
-        }
+        body(begin, end);  // its constraints may share particles: one thread, one after another
       } else {
         workers.run(end - begin, [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last); });
       }
