@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -159,10 +160,14 @@ void clampTravel(Cloth& cloth, Real maxTravel) {
   }
 }
 
-void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch) {
+void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
+                 Workers& workers) {
   // Every particle of every cloth in one spatial hash (Teschner et al. 2003): cells of size d,
   // particles counting-sorted by cell hash, neighbours found in the 27 cells around each one.
-  // Deterministic: particles are visited and stored in (cloth, index) order.
+  // Two phases: the pairs in neighbouring cells are listed (in parallel, each thread its own run of
+  // particles), then pushed apart one after another in that order, each at its distance then.
+  // Deterministic whatever the number of threads: particles are visited in (cloth, index) order
+  // and the lists are joined in the order of their runs.
   scratch.owner.clear();
   for (std::size_t c = 0; c < cloths.size(); ++c) {
     for (std::size_t i = 0; i < cloths[c].state.position.size(); ++i) {
@@ -171,68 +176,80 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
   }
   const std::size_t n = scratch.owner.size();
   const Real d = settings.distance;
-  const std::size_t tableSize = 2 * n + 1;
+  // A power of two at least 2n: the hash is masked, not divided.
+  const std::size_t tableSize = std::bit_ceil(2 * n + 1);
   // Wrapping unsigned arithmetic: no overflow whatever the cell. Positions are finite and within
   // 1e6 m (the guard), and clamped so the cell always fits.
-  const auto hashOf = [tableSize](glm::u64vec3 cell) {
+  const auto hashOf = [mask = tableSize - 1](glm::u64vec3 cell) {
     const std::uint64_t h = (cell.x * 92837111u) ^ (cell.y * 689287499u) ^ (cell.z * 283923481u);
-    return static_cast<std::size_t>(h % tableSize);
+    return static_cast<std::size_t>((h ^ (h >> 29)) & mask);
   };
-  const auto cellOf = [d](Vec3 x) { return glm::u64vec3(glm::i64vec3(glm::floor(glm::clamp(x, -2.0e6, 2.0e6) / d))); };
   const auto positionOf = [&cloths](const SelfCollisionScratch::Owner& o) -> Vec3& {
     return cloths[o.cloth].state.position[o.particle];
   };
+  scratch.cell.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    scratch.cell[k] =
+        glm::u64vec3(glm::i64vec3(glm::floor(glm::clamp(positionOf(scratch.owner[k]), -2.0e6, 2.0e6) / d)));
+  }
   scratch.start.assign(tableSize + 1, 0);
   scratch.entries.resize(n);
-  for (std::size_t k = 0; k < n; ++k) ++scratch.start[hashOf(cellOf(positionOf(scratch.owner[k]))) + 1];
+  for (std::size_t k = 0; k < n; ++k) ++scratch.start[hashOf(scratch.cell[k]) + 1];
   for (std::size_t k = 0; k < tableSize; ++k) scratch.start[k + 1] += scratch.start[k];
   scratch.fill.assign(scratch.start.begin(), scratch.start.end() - 1);
-  for (std::size_t k = 0; k < n; ++k) {
-    scratch.entries[scratch.fill[hashOf(cellOf(positionOf(scratch.owner[k])))]++] = static_cast<std::uint32_t>(k);
-  }
+  for (std::size_t k = 0; k < n; ++k)
+    scratch.entries[scratch.fill[hashOf(scratch.cell[k])]++] = static_cast<std::uint32_t>(k);
+
+  scratch.pairs.resize(static_cast<std::size_t>(workers.threads()));
+  for (std::vector<SelfCollisionScratch::Pair>& pairs : scratch.pairs) pairs.clear();
+  workers.run(
+      n,
+      [&](std::size_t begin, std::size_t end, int thread) {
+        std::vector<SelfCollisionScratch::Pair>& pairs = scratch.pairs[static_cast<std::size_t>(thread)];
+        for (std::size_t a = begin; a < end; ++a) {
+          for (int z = -1; z <= 1; ++z) {
+            for (int y = -1; y <= 1; ++y) {
+              for (int x = -1; x <= 1; ++x) {
+                const glm::u64vec3 cell = scratch.cell[a] + glm::u64vec3(glm::i64vec3(x, y, z));
+                const std::size_t bucket = hashOf(cell);
+                for (std::uint32_t k = scratch.start[bucket]; k < scratch.start[bucket + 1]; ++k) {
+                  const std::uint32_t b = scratch.entries[k];
+                  // Each particle once: it is in one cell, and cells sharing a bucket are told apart.
+                  if (b > a && scratch.cell[b] == cell) pairs.push_back({static_cast<std::uint32_t>(a), b});
+                }
+              }
+            }
+          }
+        }
+      },
+      256);
 
   const Real d2 = d * d;
-  std::array<std::size_t, 27> buckets{};
-  for (std::size_t a = 0; a < n; ++a) {
-    const auto [ca, i] = scratch.owner[a];
-    ParticleState& si = cloths[ca].state;
-    // The buckets of the 27 cells around the particle, each once: two cells may share a bucket.
-    const glm::u64vec3 cell = cellOf(si.position[i]);
-    std::size_t count = 0;
-    for (int z = -1; z <= 1; ++z) {
-      for (int y = -1; y <= 1; ++y) {
-        for (int x = -1; x <= 1; ++x) buckets[count++] = hashOf(cell + glm::u64vec3(glm::i64vec3(x, y, z)));
-      }
-    }
-    std::sort(buckets.begin(), buckets.end());
-    const auto last = std::unique(buckets.begin(), buckets.end());
-    for (auto bucket = buckets.begin(); bucket != last; ++bucket) {
-      for (std::uint32_t k = scratch.start[*bucket]; k < scratch.start[*bucket + 1]; ++k) {
-        const std::uint32_t b = scratch.entries[k];
-        if (b <= a) continue;
-        const auto [cb, j] = scratch.owner[b];
-        ParticleState& sj = cloths[cb].state;
-        const Vec3 between = sj.position[j] - si.position[i];
-        const Real distance2 = glm::dot(between, between);
-        if (distance2 >= d2 || distance2 < 1e-24) continue;
-        const Real wi = si.inverseMass[i], wj = sj.inverseMass[j];
-        if (wi + wj == 0.0) continue;
-        // Particles of one cloth closer than d at rest (neighbours) keep their rest distance.
-        const Real target =
-            ca == cb ? std::min(d, glm::length(cloths[ca].rest.restPositions[j] - cloths[ca].rest.restPositions[i]))
-                     : d;
-        const Real distance = std::sqrt(distance2);
-        if (distance >= target) continue;
-        const Vec3 push = between * ((target - distance) / (distance * (wi + wj)));
-        si.position[i] -= push * wi;
-        sj.position[j] += push * wj;
-        // Cloth-cloth friction: remove `friction` of the pair's relative velocity, shared by inverse
-        // mass (momentum is kept; a pinned particle takes none).
-        const Vec3 relative = (si.position[i] - si.previousPosition[i]) - (sj.position[j] - sj.previousPosition[j]);
-        const Vec3 change = relative * (settings.friction / (wi + wj));
-        si.previousPosition[i] += change * wi;
-        sj.previousPosition[j] -= change * wj;
-      }
+  for (const std::vector<SelfCollisionScratch::Pair>& pairs : scratch.pairs) {
+    for (const auto [a, b] : pairs) {
+      const auto [ca, i] = scratch.owner[a];
+      const auto [cb, j] = scratch.owner[b];
+      ParticleState& si = cloths[ca].state;
+      ParticleState& sj = cloths[cb].state;
+      const Vec3 between = sj.position[j] - si.position[i];
+      const Real distance2 = glm::dot(between, between);
+      if (distance2 >= d2 || distance2 < 1e-24) continue;
+      const Real wi = si.inverseMass[i], wj = sj.inverseMass[j];
+      if (wi + wj == 0.0) continue;
+      // Particles of one cloth closer than d at rest (neighbours) keep their rest distance.
+      const Real target =
+          ca == cb ? std::min(d, glm::length(cloths[ca].rest.restPositions[j] - cloths[ca].rest.restPositions[i])) : d;
+      const Real distance = std::sqrt(distance2);
+      if (distance >= target) continue;
+      const Vec3 push = between * ((target - distance) / (distance * (wi + wj)));
+      si.position[i] -= push * wi;
+      sj.position[j] += push * wj;
+      // Cloth-cloth friction: remove `friction` of the pair's relative velocity, shared by inverse
+      // mass (momentum is kept; a pinned particle takes none).
+      const Vec3 relative = (si.position[i] - si.previousPosition[i]) - (sj.position[j] - sj.previousPosition[j]);
+      const Vec3 change = relative * (settings.friction / (wi + wj));
+      si.previousPosition[i] += change * wi;
+      sj.previousPosition[j] -= change * wj;
     }
   }
 }

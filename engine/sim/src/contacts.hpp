@@ -13,6 +13,7 @@
 #include "drape/sim/settings.hpp"
 #include "drape/sim/state.hpp"
 #include "drape/sim/world.hpp"
+#include "workers.hpp"
 
 namespace drape::sim::contact {
 
@@ -34,6 +35,7 @@ void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders,
 // travels more than maxTravel in a substep on its own momentum, too little to pass through a layer.
 void clampTravel(Cloth& cloth, Real maxTravel);
 // Works across all cloths of the world, so two cloths collide with each other too.
-void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch);
+void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
+                 Workers& workers);
 
 }  // namespace drape::sim::contact

@@ -352,7 +352,8 @@ MemoryUse World::memoryUse() const {
   }
   for (const std::vector<std::uint8_t>& held : held_) m.solver += bytes(held);
   const SelfCollisionScratch& h = selfCollisionScratch_;
-  m.solver += bytes(h.owner) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
+  m.solver += bytes(h.owner) + bytes(h.cell) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
+  for (const auto& pairs : h.pairs) m.solver += bytes(pairs);
   return m;
 }
 
@@ -402,7 +403,7 @@ void World::runStage(Stage stage) {
   // every cloth at once.
   if (stage == Stage::collide || stage == Stage::collideForces) moveColliders();
   if (stage == Stage::selfCollide) {
-    contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_);
+    contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_, *workers_);
     return;
   }
   if (stage == Stage::fingers) {

@@ -74,8 +74,13 @@ struct SelfCollisionScratch {
     std::uint32_t cloth;
     std::uint32_t particle;
   };
-  std::vector<Owner> owner;  // hash entry -> particle
+  struct Pair {
+    std::uint32_t a, b;  // entries of owner, a < b
+  };
+  std::vector<Owner> owner;        // hash entry -> particle
+  std::vector<glm::u64vec3> cell;  // of each entry, when the hash was built
   std::vector<std::uint32_t> start, fill, entries;
+  std::vector<std::vector<Pair>> pairs;  // pairs within reach, one list per thread
 };
 
 }  // namespace drape::sim

@@ -8,6 +8,8 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/ext/vector_int3_sized.hpp>
+#include <glm/ext/vector_uint3_sized.hpp>
 #include <glm/vec3.hpp>
 
 namespace drape::sim {
