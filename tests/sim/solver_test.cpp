@@ -256,21 +256,11 @@ WorldSettings fastSheet(int n, int substeps) {
   return world;
 }
 
-std::vector<Vec3> positionsAfter(WorldSettings settings, int threads, int steps) {
-  World world(std::move(settings));
-  world.setThreads(threads);
-  world.run(steps);
-  std::vector<Vec3> all;
-  for (const Cloth& cloth : world.cloths())
-    all.insert(all.end(), cloth.state.position.begin(), cloth.state.position.end());
-  return all;
-}
-
 TEST(FastSweep, OneTwoOrFiveThreadsGiveTheSameResultBitForBit) {
   const WorldSettings settings = fastSheet(48, 4);
-  const std::vector<Vec3> one = positionsAfter(settings, 1, 40);
-  EXPECT_EQ(positionsAfter(settings, 2, 40), one);
-  EXPECT_EQ(positionsAfter(settings, 5, 40), one);
+  const std::vector<Vec3> one = test::positionsAfter(settings, 1, 40);
+  EXPECT_EQ(test::positionsAfter(settings, 2, 40), one);
+  EXPECT_EQ(test::positionsAfter(settings, 5, 40), one);
 }
 
 TEST(FastSweep, ThreadsStayBitIdenticalThroughTearingAndXpbd) {
@@ -281,35 +271,9 @@ TEST(FastSweep, ThreadsStayBitIdenticalThroughTearingAndXpbd) {
   World probe(settings);
   probe.run(60);
   ASSERT_GT(probe.cloths()[0].pieceCount, 1u) << "the test needs a tear";
-  const std::vector<Vec3> one = positionsAfter(settings, 1, 60);
-  EXPECT_EQ(positionsAfter(settings, 2, 60), one);
-  EXPECT_EQ(positionsAfter(settings, 3, 60), one);
-}
-
-TEST(SelfCollision, ThreadsListThePairsYetGiveTheSameResultBitForBit) {
-  // A cloth dropped onto another on the floor: self-collision's pairs are listed by several threads
-  // and must still be pushed apart in the one order a single thread uses.
-  WorldSettings settings;
-  settings.solver.substeps = 4;
-  settings.solver.iterations = 2;
-  ClothSettings below;
-  below.lattice = {24, 24, 0.6, 0.6, Vec3{-0.3, 0.006, -0.3}, LatticePlane::xz};
-  ClothSettings above = below;
-  above.lattice = {16, 16, 0.4, 0.4, Vec3{-0.2, 0.1, -0.2}, LatticePlane::xz};
-  settings.cloths = {below, above};
-  ColliderSettings floor;
-  floor.shape = ColliderShape::plane;
-  floor.normal = {0.0, 1.0, 0.0};
-  settings.colliders.push_back(floor);
-  settings.selfCollision = {true, 0.03, 0.3, 0.5};
-  const std::vector<Vec3> one = positionsAfter(settings, 1, 40);
-  World probe(settings);
-  probe.run(40);
-  Real lowest = 1.0;
-  for (const Vec3& x : probe.cloths()[1].state.position) lowest = std::min(lowest, x.y);
-  ASSERT_GT(lowest, ClothSettings{}.thickness + 0.5 * 0.03) << "the test needs the upper cloth lying on the lower";
-  EXPECT_EQ(positionsAfter(settings, 2, 40), one);
-  EXPECT_EQ(positionsAfter(settings, 3, 40), one);
+  const std::vector<Vec3> one = test::positionsAfter(settings, 1, 60);
+  EXPECT_EQ(test::positionsAfter(settings, 2, 60), one);
+  EXPECT_EQ(test::positionsAfter(settings, 3, 60), one);
 }
 
 TEST(FastSweep, KeepsTheHangingSheetTautWhereGaussSeidelLetsItStretch) {
@@ -455,8 +419,8 @@ TEST(FastSweep, ASecondTearOfAChainBreaksTheLinkThatIsPulled) {
 TEST(FastSweep, TwoThreadsShareLinesAndParticlesAndStayBitIdentical) {
   // Large enough that the line solves, the batches and the integration are all cut in two.
   const WorldSettings settings = fastSheet(130, 2);
-  const std::vector<Vec3> one = positionsAfter(settings, 1, 5);
-  EXPECT_EQ(positionsAfter(settings, 2, 5), one);
+  const std::vector<Vec3> one = test::positionsAfter(settings, 1, 5);
+  EXPECT_EQ(test::positionsAfter(settings, 2, 5), one);
 }
 
 TEST(Lines, XpbdLooseLinksKeepTheirCompliance) {

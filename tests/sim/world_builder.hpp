@@ -1,7 +1,10 @@
 // Small settings builders for engine tests.
 #pragma once
 
+#include <vector>
+
 #include "drape/sim/settings.hpp"
+#include "drape/sim/world.hpp"
 
 namespace drape::sim::test {
 
@@ -52,6 +55,17 @@ inline WorldSettings hangingSheet(int n, int iterations, int substeps) {
   cloth.pins = {{0, 0, std::nullopt}, {n - 1, 0, std::nullopt}};
   world.cloths.push_back(cloth);
   return world;
+}
+
+// Every particle's position, cloth after cloth, after `steps` steps on `threads` threads.
+inline std::vector<Vec3> positionsAfter(WorldSettings settings, int threads, int steps) {
+  World world(std::move(settings));
+  world.setThreads(threads);
+  world.run(steps);
+  std::vector<Vec3> all;
+  for (const Cloth& cloth : world.cloths())
+    all.insert(all.end(), cloth.state.position.begin(), cloth.state.position.end());
+  return all;
 }
 
 }  // namespace drape::sim::test

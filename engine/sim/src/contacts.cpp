@@ -222,7 +222,7 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
           }
         }
       },
-      256);
+      128);
 
   const Real d2 = d * d;
   for (const std::vector<SelfCollisionScratch::Pair>& pairs : scratch.pairs) {
