@@ -263,6 +263,10 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       changed |= ImGui::Checkbox("tethers", &tuned.solver.tethers);
       ImGui::SameLine();
       changed |= ImGui::Checkbox("lines", &tuned.solver.lines);
+      if (tuned.solver.lines) {
+        ImGui::SameLine();
+        changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
+      }
     }
     int threads = session.threads();
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

@@ -308,5 +308,17 @@ TEST(SceneReader, XpbdTethersAndComplianceBelongToThePositionModel) {
             "s.json: solver.tethers: expected false for the force model (it belongs to the position model), got true");
 }
 
+TEST(SceneReader, GeometricStiffnessIsPartOfTheLineSolve) {
+  json document = minimal();
+  applyOverride(document, "solver.lines=true");
+  applyOverride(document, "solver.geometricStiffness=true");
+  EXPECT_TRUE(parseScene(document, "s.json").world.solver.geometricStiffness);
+  EXPECT_FALSE(parseScene(minimal(), "s.json").world.solver.geometricStiffness);
+  applyOverride(document, "solver.lines=false");
+  EXPECT_EQ(errorOf([&] { parseScene(document, "s.json"); }),
+            "s.json: solver.geometricStiffness: expected false unless \"lines\" is true (it is part of the line "
+            "solve), got true");
+}
+
 }  // namespace
 }  // namespace drape::scene

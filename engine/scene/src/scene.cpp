@@ -203,12 +203,17 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.xpbd = solver.boolean("xpbd", false);
     world.solver.tethers = solver.boolean("tethers", false);
     world.solver.lines = solver.boolean("lines", false);
+    world.solver.geometricStiffness = solver.boolean("geometricStiffness", false);
     if (world.solver.model != Model::position) {
-      for (const char* key : {"xpbd", "tethers", "lines"}) {
+      for (const char* key : {"xpbd", "tethers", "lines", "geometricStiffness"}) {
         if (solver.has(key) && solver.boolean(key, false)) {
           solver.fail(key, "false for the force model (it belongs to the position model)", solver.raw(key));
         }
       }
+    }
+    if (world.solver.geometricStiffness && !world.solver.lines) {
+      solver.fail("geometricStiffness", "false unless \"lines\" is true (it is part of the line solve)",
+                  solver.raw("geometricStiffness"));
     }
     solver.finish();
   }
@@ -295,7 +300,7 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
     for (sim::ClothSettings& cloth : changed.world.cloths) {
       for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(model, kind);
     }
-    if (model == Model::force) solver.xpbd = solver.tethers = solver.lines = false;
+    if (model == Model::force) solver.xpbd = solver.tethers = solver.lines = solver.geometricStiffness = false;
   }
   solver.model = model;
   solver.integrator = integrator;
@@ -309,6 +314,7 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
       solverDocument.erase("xpbd");
       solverDocument.erase("tethers");
       solverDocument.erase("lines");
+      solverDocument.erase("geometricStiffness");
     }
     if (document.contains("cloths") && document["cloths"].is_array()) {
       for (json& cloth : document["cloths"]) {

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <type_traits>
 
 #include <glm/geometric.hpp>
 
@@ -92,34 +93,183 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
   }
 }
 
-// Lines [first, last) of a family: four at a time where four in a row are equally long.
-void solveFamily(ParticleState& s, SolverScratch::LineFamily& lines, std::size_t first, std::size_t last,
-                 Real stiffness, bool xpbd, Real alphaTilde, Vec3* normal, Real* upper, Real* solution) {
+// A symmetric 3 x 3 matrix.
+struct Sym3 {
+  Real xx = 0.0, yy = 0.0, zz = 0.0, xy = 0.0, xz = 0.0, yz = 0.0;
+  Vec3 operator*(Vec3 u) const {
+    return {xx * u.x + xy * u.y + xz * u.z, xy * u.x + yy * u.y + yz * u.z, xz * u.x + yz * u.y + zz * u.z};
+  }
+  Sym3 operator+(const Sym3& o) const { return {xx + o.xx, yy + o.yy, zz + o.zz, xy + o.xy, xz + o.xz, yz + o.yz}; }
+  Sym3 operator*(Real a) const { return {xx * a, yy * a, zz * a, xy * a, xz * a, yz * a}; }
+};
+Sym3 diagonal(Real a) { return {a, a, a, 0.0, 0.0, 0.0}; }
+Sym3 outer(Vec3 u) { return {u.x * u.x, u.y * u.y, u.z * u.z, u.x * u.y, u.x * u.z, u.y * u.z}; }
+// u v^T + v u^T
+Sym3 outer(Vec3 u, Vec3 v) {
+  return {2.0 * u.x * v.x,       2.0 * u.y * v.y,       2.0 * u.z * v.z,
+          u.x * v.y + u.y * v.x, u.x * v.z + u.z * v.x, u.y * v.z + u.z * v.y};
+}
+Sym3 inverse(const Sym3& a) {
+  const Real cxx = a.yy * a.zz - a.yz * a.yz, cxy = a.xz * a.yz - a.xy * a.zz, cxz = a.xy * a.yz - a.xz * a.yy;
+  const Real inv = 1.0 / (a.xx * cxx + a.xy * cxy + a.xz * cxz);
+  return {cxx * inv, (a.xx * a.zz - a.xz * a.xz) * inv, (a.xx * a.yy - a.xy * a.xy) * inv, cxy * inv,
+          cxz * inv, (a.xy * a.xz - a.xx * a.yz) * inv};
+}
+
+// One full Newton step of a line's projection from where its particles are now, geometric
+// stiffness included: with dx the particles' moves and l the links' multipliers,
+//   K dx - J^T l = 0,   J dx + alpha~ l = -(C + alpha~ lambda),
+//   K = M + sum_k G_k (on link k's two particles: [G, -G; -G, G]), G_k = g_k (I - n_k n_k^T),
+// g_k = the link's tension (times h^2, from the last substep) over its length. Without G this is
+// the tridiagonal solve above; with it a particle's sideways move drags its neighbours, as a taut
+// string's does. The unknowns are eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of
+// one particle and one link (a 4 x 4 block, its 3 x 3 part inverted), so a pinned particle (which
+// does not move: its unknowns drop out) never leaves a link's multiplier without a pivot.
+template <std::size_t G>
+void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
+                     const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
+                     const std::array<const Real*, G>& tension, const std::array<Real*, G>& tensionSum, std::size_t n,
+                     Real stiffness, Real alphaTilde, SolverScratch::StiffRow* rows) {
+  Vec3* x = s.position.data();
+  const Real* w = s.inverseMass.data();
+  const Real* m = s.mass.data();
+  const std::size_t links = n - 1;
+  // Row of particle (and link) k of line g.
+  const auto at = [&](std::size_t k, std::size_t g) -> SolverScratch::StiffRow& { return rows[k * G + g]; };
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t g = 0; g < G; ++g) {
+      SolverScratch::StiffRow& r = at(k, g);
+      r.live = false;
+      r.n = Vec3{0.0};
+      r.g = r.rhs = 0.0;
+      if (k == links) continue;
+      const Vec3 d = x[p[g][k + 1]] - x[p[g][k]];
+      const Real length2 = glm::dot(d, d);
+      if (!(length2 > 1e-20 && w[p[g][k]] + w[p[g][k + 1]] + alphaTilde > 0.0)) continue;
+      const Real length = std::sqrt(length2);
+      r.live = true;
+      r.n = d * (1.0 / length);
+      r.rhs = (length - rest[g][k]) + (lambda[g] ? alphaTilde * lambda[g][k] : 0.0);
+      r.g = std::max(-tension[g][k], 0.0) / length;  // pulled links only: a pushed one would make K indefinite
+    }
+  }
+  // G_k u, and G_k as a matrix.
+  const auto pull = [](const SolverScratch::StiffRow& link, Vec3 u) {
+    return (u - link.n * glm::dot(link.n, u)) * link.g;
+  };
+  const auto geometric = [](const SolverScratch::StiffRow& link) {
+    return (diagonal(1.0) + outer(link.n) * -1.0) * link.g;
+  };
+  const auto load = [](const SolverScratch::StiffRow& r) {
+    return Sym3{r.inverse[0], r.inverse[1], r.inverse[2], r.inverse[3], r.inverse[4], r.inverse[5]};
+  };
+  const auto store = [](SolverScratch::StiffRow& r, const Sym3& a) {
+    r.inverse = {a.xx, a.yy, a.zz, a.xy, a.xz, a.yz};
+  };
+
+  // Forward. P is the last node's (S^-1)_xx, zx its (S^-1 y)_x: what it passes on through the link.
+  std::array<Sym3, G> P;
+  std::array<Vec3, G> zx;
+  for (std::size_t g = 0; g < G; ++g) {
+    SolverScratch::StiffRow& r = at(0, g);
+    P[g] = w[p[g][0]] > 0.0 ? inverse(diagonal(m[p[g][0]]) + geometric(r)) : Sym3{};
+    zx[g] = Vec3{0.0};
+    store(r, P[g]);
+    r.v = r.b = r.yx = Vec3{0.0};
+    r.schur = 1.0;
+    r.yl = 0.0;
+  }
+  for (std::size_t j = 1; j < n; ++j) {
+    for (std::size_t g = 0; g < G; ++g) {
+      const SolverScratch::StiffRow& link = at(j - 1, g);  // joins particle j - 1 to j
+      SolverScratch::StiffRow& r = at(j, g);
+      const Vec3 Pn = P[g] * link.n;
+      const Real nPn = glm::dot(link.n, Pn);
+      r.b = pull(link, Pn) - link.n;
+      const Real c = link.live ? -alphaTilde - nPn : 1.0;
+      r.yx = pull(link, zx[g]);
+      r.yl = link.live ? link.rhs - glm::dot(link.n, zx[g]) : 0.0;
+      Sym3 inverseA;
+      if (w[p[g][j]] > 0.0) {
+        // A = m I + G_{j-1} + G_j - G_{j-1} P G_{j-1}
+        Sym3 A = diagonal(m[p[g][j]]);
+        if (link.g > 0.0) {
+          A = A + geometric(link) + (P[g] + outer(link.n, Pn) * -1.0 + outer(link.n) * nPn) * (-link.g * link.g);
+        }
+        if (r.g > 0.0) A = A + geometric(r);
+        inverseA = inverse(A);
+        r.v = inverseA * r.b;
+        r.schur = c - glm::dot(r.b, r.v);
+      } else {
+        r.v = Vec3{0.0};
+        r.schur = c;
+      }
+      store(r, inverseA);
+      // Both particles held: the link cannot be corrected.
+      if (!(std::abs(r.schur) > 0.0)) {
+        r.schur = 1.0;
+        r.yl = 0.0;
+      }
+      r.schur = 1.0 / r.schur;  // from here on, its inverse
+      const Vec3 t = inverseA * r.yx;
+      const Real zl = (r.yl - glm::dot(r.b, t)) * r.schur;
+      zx[g] = t - r.v * zl;
+      P[g] = inverseA + outer(r.v) * r.schur;
+    }
+  }
+
+  // Back: particle j's move and link j - 1's multiplier, from node j + 1's.
+  std::array<Vec3, G> ux;
+  std::array<Real, G> ul{};
+  ux.fill(Vec3{0.0});
+  for (std::size_t j = n; j-- > 0;) {
+    for (std::size_t g = 0; g < G; ++g) {
+      const SolverScratch::StiffRow& r = at(j, g);
+      Vec3 px = r.yx;
+      if (j + 1 < n) px += pull(r, ux[g]) - r.n * ul[g];  // minus link j's coupling to node j + 1
+      const Vec3 t = load(r) * px;
+      ul[g] = j > 0 ? (r.yl - glm::dot(r.b, t)) * r.schur : 0.0;
+      ux[g] = t - r.v * ul[g];
+      if (w[p[g][j]] > 0.0) x[p[g][j]] += ux[g] * stiffness;
+      if (j > 0 && at(j - 1, g).live) {
+        if (lambda[g]) lambda[g][j - 1] += ul[g] * stiffness;
+        tensionSum[g][j - 1] += ul[g] * stiffness;
+      }
+    }
+  }
+}
+
+// Lines [first, last) of a family, four at a time where four in a row are equally long (G = 4),
+// else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests, lambdas,
+// offsets, n), each array holding G lines' pointers (lambdas null without XPBD) and offsets their
+// starts.
+template <class Solve>
+void inGroups(SolverScratch::LineFamily& lines, std::size_t first, std::size_t last, bool xpbd, Solve&& solve) {
   constexpr std::size_t G = 4;
   const auto length = [&](std::size_t l) { return lines.start[l + 1] - lines.start[l]; };
-  const auto lambdaOf = [&](std::size_t l) { return xpbd ? lines.lambda.data() + lines.start[l] : nullptr; };
-  const Real alpha = xpbd ? alphaTilde : 0.0;
+  const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t l, std::size_t n) {
+    std::array<const ParticleIndex*, N> p{};
+    std::array<const Real*, N> rest{};
+    std::array<Real*, N> lambda{};
+    std::array<std::size_t, N> offset{};
+    for (std::size_t g = 0; g < N; ++g) {
+      offset[g] = lines.start[l + g];
+      p[g] = lines.particle.data() + offset[g];
+      rest[g] = lines.rest.data() + offset[g];
+      lambda[g] = xpbd ? lines.lambda.data() + offset[g] : nullptr;
+    }
+    solve(size, p, rest, lambda, offset, n);
+  };
   for (std::size_t l = first; l < last;) {
     const std::size_t n = length(l);
     bool group = l + G <= last && n >= 2;
     for (std::size_t g = 1; group && g < G; ++g) group = length(l + g) == n;
     if (group) {
-      std::array<const ParticleIndex*, G> p{};
-      std::array<const Real*, G> rest{};
-      std::array<Real*, G> lambda{};
-      for (std::size_t g = 0; g < G; ++g) {
-        p[g] = lines.particle.data() + lines.start[l + g];
-        rest[g] = lines.rest.data() + lines.start[l + g];
-        lambda[g] = lambdaOf(l + g);
-      }
-      solveLines<G>(s, p, rest, lambda, n, stiffness, alpha, normal, upper, solution);
+      gather(std::integral_constant<std::size_t, G>{}, l, n);
       l += G;
       continue;
     }
-    if (n >= 2) {
-      solveLines<1>(s, {lines.particle.data() + lines.start[l]}, {lines.rest.data() + lines.start[l]}, {lambdaOf(l)}, n,
-                    stiffness, alpha, normal, upper, solution);
-    }
+    if (n >= 2) gather(std::integral_constant<std::size_t, 1>{}, l, n);
     ++l;
   }
 }
@@ -189,9 +339,17 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
   scratch.lineSolution.assign(slices, 0.0);
 }
 
-void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, Workers& workers,
-           Real* looseLambda) {
+void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+           Workers& workers, Real* looseLambda) {
   ParticleState& s = cloth.state;
+  if (geometricStiffness) {
+    const std::size_t rows = scratch.lineStride * static_cast<std::size_t>(workers.threads());
+    if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
+    for (SolverScratch::LineFamily& lines : scratch.lines) {
+      lines.tension.resize(lines.rest.size(), 0.0);
+      lines.tensionSum.resize(lines.rest.size(), 0.0);
+    }
+  }
   // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
   // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
   // it does not (docs/performance.md).
@@ -205,9 +363,30 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
       workers.run(
           count,
           [&](std::size_t first, std::size_t last, int thread) {
+            const Real alpha = xpbd ? alphaTilde : 0.0;
+            if (geometricStiffness) {
+              SolverScratch::StiffRow* rows =
+                  scratch.lineStiff.data() + scratch.lineStride * static_cast<std::size_t>(thread);
+              inGroups(lines, first, last, xpbd,
+                       [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
+                                          const auto& lambda, const auto& offset, std::size_t n) {
+                         std::array<const Real*, G> tension{};
+                         std::array<Real*, G> tensionSum{};
+                         for (std::size_t g = 0; g < G; ++g) {
+                           tension[g] = lines.tension.data() + offset[g];
+                           tensionSum[g] = lines.tensionSum.data() + offset[g];
+                         }
+                         solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha, rows);
+                       });
+              return;
+            }
             const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
-            solveFamily(s, lines, first, last, stiffness, xpbd, alphaTilde, scratch.lineNormal.data() + slice,
-                        scratch.lineUpper.data() + slice, scratch.lineSolution.data() + slice);
+            inGroups(lines, first, last, xpbd,
+                     [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
+                                        const auto& lambda, const auto&, std::size_t n) {
+                       solveLines<G>(s, p, rest, lambda, n, stiffness, alpha, scratch.lineNormal.data() + slice,
+                                     scratch.lineUpper.data() + slice, scratch.lineSolution.data() + slice);
+                     });
           },
           std::max<std::size_t>(2048 / perLine, 1));
     }

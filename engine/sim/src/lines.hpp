@@ -27,7 +27,10 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads);
 // The lines of a family are independent: they are shared among the workers.
 // The loose stretch constraints are projected one by one, with XPBD into `looseLambda` (indexed
 // like the cloth's stretch constraints).
-void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, Workers& workers,
-           Real* looseLambda);
+// With `geometricStiffness` each line's solve is a full Newton step, the links' geometric
+// stiffness from the tension they carried over the last substep (scratch.lines[f].tension) included;
+// each solve adds its multipliers to tensionSum (position_model.cpp moves it to tension each substep).
+void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+           Workers& workers, Real* looseLambda);
 
 }  // namespace drape::sim::lines

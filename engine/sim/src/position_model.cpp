@@ -240,8 +240,8 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     if (material.stiffness == 0.0) continue;
     const Real alphaTilde = material.compliance / (h * h);
     if (kind == ConstraintKind::stretch) {
-      lines::solve(cloth, scratch, solver.xpbd ? 1.0 : material.stiffness, solver.xpbd, alphaTilde, workers,
-                   scratch.lambda[kindIndex].data());
+      lines::solve(cloth, scratch, solver.xpbd ? 1.0 : material.stiffness, solver.xpbd, alphaTilde,
+                   solver.geometricStiffness, workers, scratch.lambda[kindIndex].data());
       continue;
     }
     const DistanceConstraint* constraints = cloth.rest.of(kind).data();
@@ -275,6 +275,14 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
     }
     if (solver.lines) {
       for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.rest.size(), 0.0);
+    }
+  }
+  if (solver.lines && solver.geometricStiffness) {
+    // The multipliers this substep's line solves add up become the tension the next one's use.
+    for (SolverScratch::LineFamily& family : scratch.lines) {
+      family.tension.swap(family.tensionSum);
+      family.tension.resize(family.rest.size(), 0.0);
+      family.tensionSum.assign(family.rest.size(), 0.0);
     }
   }
   for (int iteration = 0; iteration < solver.iterations; ++iteration) {

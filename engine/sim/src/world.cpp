@@ -299,6 +299,7 @@ void World::plan(std::size_t c) {
     scratch.lineNormal.clear();
     scratch.lineUpper.clear();
     scratch.lineSolution.clear();
+    scratch.lineStiff.clear();
   }
   scratch.planVersion = topologyVersion_;
 }
@@ -341,10 +342,11 @@ MemoryUse World::memoryUse() const {
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
                 bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.looseStretch) + bytes(s.lineNormal) +
-                bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.batchStart);
+                bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart);
     m.tethers += bytes(s.tethers);
     for (const SolverScratch::LineFamily& f : s.lines) {
-      m.lines += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda);
+      m.lines +=
+          bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda) + bytes(f.tension) + bytes(f.tensionSum);
     }
   }
   for (const Snapshot& snapshot : lastGood_) {

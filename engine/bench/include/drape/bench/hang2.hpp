@@ -8,12 +8,14 @@
 namespace drape::bench {
 
 // How Drape solves it (the configuration the benchmark reports): tethers to the two pins, each
-// row and column of stretch constraints solved at once, `substeps` substeps of one sweep each.
+// row and column of stretch constraints solved at once with the links' geometric stiffness,
+// `substeps` substeps of one sweep each.
 struct Hang2Solver {
-  int substeps = 8;
+  int substeps = 2;
   int iterations = 1;
   bool lines = true;
   bool tethers = true;
+  bool geometricStiffness = true;
 };
 
 sim::WorldSettings hang2(int n, const Hang2Solver& solver = {});

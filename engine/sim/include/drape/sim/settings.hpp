@@ -52,6 +52,12 @@ struct SolverSettings {
   // cloth), instead of one constraint at a time. A sweep then carries a correction along the whole
   // line, where Gauss-Seidel carries it one particle.
   bool lines = false;
+  // Position model, with lines: each line's solve is a full Newton step of its projection, the
+  // links' geometric stiffness (their tension over their length, from the last substep) included
+  // (Tournier et al. 2015, Andrews et al. 2017). Without it a taut line's sideways kinks are
+  // stepped explicitly, and grow unless the substep is shorter than a wave takes to cross a link;
+  // with it the substeps a stiff cloth needs no longer grow with its resolution.
+  bool geometricStiffness = false;
 };
 
 // The air around the cloth, moving uniformly at `velocity`.

@@ -4,10 +4,9 @@
 
 #include <array>
 #include <cstdint>
-
 #include <vector>
-#include "drape/sim/cloth.hpp"
 
+#include "drape/sim/cloth.hpp"
 #include "drape/sim/types.hpp"
 
 namespace drape::sim {
@@ -54,6 +53,9 @@ struct SolverScratch {
     std::vector<ParticleIndex> particle;
     std::vector<Real> rest;    // m, link k joins particle[k] and particle[k + 1] (unused at a line's end)
     std::vector<Real> lambda;  // XPBD: multiplier of link k, reset each substep
+    // solver.geometricStiffness: the sum of link k's multipliers over the last substep (its
+    // tension times h^2, negative when pulled), and over this one so far.
+    std::vector<Real> tension, tensionSum;
   };
   std::array<LineFamily, 2> lines;          // along x, and across
   std::vector<std::uint32_t> looseStretch;  // stretch constraints in no line: solved one by one
@@ -61,6 +63,19 @@ struct SolverScratch {
   std::size_t lineStride = 0;
   std::vector<Vec3> lineNormal;
   std::vector<Real> lineUpper, lineSolution;
+  // ... and of the line solve with geometric stiffness: one row per particle of a line.
+  struct StiffRow {
+    Vec3 n{0.0};                    // direction of the link to the next particle
+    Real g = 0.0;                   // its geometric stiffness: G = g (I - n n^T)
+    Real rhs = 0.0;                 // its constraint value, C + alpha~ lambda
+    bool live = false;              // a link the solve corrects
+    std::array<Real, 6> inverse{};  // A^-1 of the particle's eliminated block (symmetric)
+    Vec3 v{0.0}, b{0.0};
+    Real schur = 1.0;  // the link multiplier's pivot, then its inverse
+    Vec3 yx{0.0};
+    Real yl = 0.0;
+  };
+  std::vector<StiffRow> lineStiff;
   // Each kind's constraints come in batches that share no particle (batches.hpp): batch b is
   // [batchStart[b], batchStart[b + 1]); with sequentialTail the last batch is not one.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;
