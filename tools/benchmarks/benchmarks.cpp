@@ -19,7 +19,7 @@ constexpr int kFrames = 120;
 
 // Substeps that keep hang2 within 5 % strain at every frame (drape-cli bench finds them; see
 // docs/performance.md).
-int substepsFor(int n) { return n <= 128 ? 2 : 3; }
+int substepsFor(int n) { return n <= 128 ? 2 : 4; }
 
 void Hang2(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));

@@ -30,8 +30,8 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
 template <std::size_t G>
 void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, const std::array<const Real*, G>& rest,
-                const std::array<Real*, G>& lambda, std::size_t n, Real stiffness, Real alphaTilde, Vec3* normal,
-                Real* upper, Real* solution) {
+                const std::array<Real*, G>& lambda, const std::array<Real*, G>& tensionSum, std::size_t n,
+                Real stiffness, Real alphaTilde, Vec3* normal, Real* upper, Real* solution) {
   const std::size_t links = n - 1;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -86,6 +86,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
       const std::size_t at = k * G + g;
       const Real dl = solution[at] * stiffness;
       if (lambda[g]) lambda[g][k] += dl;
+      if (tensionSum[g]) tensionSum[g][k] += dl;
       const Vec3 push = normal[at] * dl;
       x[p[g][k]] -= push * w[p[g][k]];
       x[p[g][k + 1]] += push * w[p[g][k + 1]];
@@ -352,7 +353,9 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
   }
   // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
   // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
-  // it does not (docs/performance.md).
+  // it does not (docs/performance.md). With geometric stiffness the first step is the full Newton
+  // step (which keeps kinks from growing) and the second the tridiagonal one (which only refines the
+  // lengths): taking both full costs 1.7 times as much on hang2 for no stiffer a cloth.
   for (int step = 0; step < kNewtonSteps; ++step) {
     for (SolverScratch::LineFamily& lines : scratch.lines) {
       if (lines.start.size() < 2) continue;
@@ -364,28 +367,25 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
           count,
           [&](std::size_t first, std::size_t last, int thread) {
             const Real alpha = xpbd ? alphaTilde : 0.0;
-            if (geometricStiffness) {
-              SolverScratch::StiffRow* rows =
-                  scratch.lineStiff.data() + scratch.lineStride * static_cast<std::size_t>(thread);
-              inGroups(lines, first, last, xpbd,
-                       [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                          const auto& lambda, const auto& offset, std::size_t n) {
-                         std::array<const Real*, G> tension{};
-                         std::array<Real*, G> tensionSum{};
-                         for (std::size_t g = 0; g < G; ++g) {
-                           tension[g] = lines.tension.data() + offset[g];
-                           tensionSum[g] = lines.tensionSum.data() + offset[g];
-                         }
-                         solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha, rows);
-                       });
-              return;
-            }
             const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
             inGroups(lines, first, last, xpbd,
                      [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                        const auto& lambda, const auto&, std::size_t n) {
-                       solveLines<G>(s, p, rest, lambda, n, stiffness, alpha, scratch.lineNormal.data() + slice,
-                                     scratch.lineUpper.data() + slice, scratch.lineSolution.data() + slice);
+                                        const auto& lambda, const auto& offset, std::size_t n) {
+                       // With geometric stiffness every solve adds its multipliers to the tension sums.
+                       std::array<const Real*, G> tension{};
+                       std::array<Real*, G> tensionSum{};
+                       for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
+                         tension[g] = lines.tension.data() + offset[g];
+                         tensionSum[g] = lines.tensionSum.data() + offset[g];
+                       }
+                       if (geometricStiffness && step == 0) {
+                         solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                            scratch.lineStiff.data() + slice);
+                       } else {
+                         solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
+                                       scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
+                                       scratch.lineSolution.data() + slice);
+                       }
                      });
           },
           std::max<std::size_t>(2048 / perLine, 1));
