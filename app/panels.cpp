@@ -263,10 +263,8 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       changed |= ImGui::Checkbox("tethers", &tuned.solver.tethers);
       ImGui::SameLine();
       changed |= ImGui::Checkbox("lines", &tuned.solver.lines);
-      if (tuned.solver.lines) {
-        ImGui::SameLine();
-        changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
-      }
+      // On a line of its own: the row above is full.
+      if (tuned.solver.lines) changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
     }
     int threads = session.threads();
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
