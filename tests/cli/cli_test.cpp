@@ -375,6 +375,24 @@ TEST_F(Cli, StudyChoosesTheCheapestRunWithinTheStrainBound) {
   EXPECT_NE(read(report).find("lower strain wins): substeps=8"), std::string::npos);
 }
 
+TEST_F(Cli, BenchQuickKeepsWhatIsGivenExplicitly) {
+  // --quick stands for N = 16 and 24; given --sizes 20, only 20 is timed.
+  const fs::path folder = file("quick");
+  const Result result =
+      run("bench --quick --sizes 20 --threads 1 --naive-iterations 0 --scenes '' --quiet --out-dir '" +
+          folder.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::istringstream csv(read(folder / "performance.csv"));
+  std::string line;
+  std::getline(csv, line);  // header
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    EXPECT_EQ(line.rfind("hang2,20,400,drape,1,", 0), 0u) << line;
+  }
+  EXPECT_EQ(rows, 1);
+}
+
 TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
   const fs::path folder = file("performance"), report = file("performance.md");
   const Result result = run("bench --quick --scenes hang2-tear --quiet --out-dir '" + folder.string() + "' --report '" +

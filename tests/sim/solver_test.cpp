@@ -80,7 +80,8 @@ TEST(Lines, WithoutTensionTheStiffSolveIsTheTridiagonalOne) {
   // block elimination gives the moves of the scalar tridiagonal solve, to rounding.
   Cloth bent = chain(50, 1.0);
   for (std::size_t i = 1; i < bent.state.position.size(); ++i) {
-    bent.state.position[i] += Vec3{0.0, 0.002 * std::sin(0.4 * static_cast<Real>(i)), 0.001 * std::cos(0.7 * i)};
+    bent.state.position[i] +=
+        Vec3{0.0, 0.002 * std::sin(0.4 * static_cast<Real>(i)), 0.001 * std::cos(0.7 * static_cast<Real>(i))};
   }
   Cloth stiff = bent;
   SolverScratch plain, withStiffness;

@@ -100,12 +100,6 @@ std::string plotScript(const std::filesystem::path& directory, const std::vector
 int bench(const BenchArguments& input) {
   try {
     BenchArguments arguments = input;
-    if (arguments.quick) {
-      arguments.sizes = {16, 24};
-      arguments.frames = 10;
-      arguments.repeats = 1;
-      arguments.naiveIterations = {10};
-    }
     std::erase(arguments.naiveIterations, 0);  // 0: no baseline
     // Smallest first, each once: the report compares the first size with the last.
     for (std::vector<int>* list : {&arguments.sizes, &arguments.threads, &arguments.naiveIterations}) {

@@ -75,7 +75,7 @@ struct BenchArguments {
   int frames = 120;
   int repeats = 3;     // timed runs (median); fewer once a case has taken 20 s
   int substeps = 0;    // Drape's hang2 substeps (of one sweep); 0: the fewest that keep strain within 5 %
-  bool quick = false;  // a smoke test: small sizes, few frames
+  bool quick = false;  // a smoke test: small sizes, few frames (main.cpp applies it to the options not given)
   std::string outDir = "performance";
   std::optional<std::string> report;
   bool quiet = false;

@@ -133,7 +133,8 @@ int main(int argc, char** argv) {
       ->add_option("--substeps", benchArguments.substeps,
                    "Substeps of Drape's hang2 solver (default: the fewest that keep strain within 5 % at every frame)")
       ->check(CLI::Range(1, 1000));
-  benchCommand->add_flag("--quick", benchArguments.quick, "Smoke test: N = 16, 24, 10 frames, one repeat");
+  benchCommand->add_flag("--quick", benchArguments.quick,
+                         "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps (each unless given)");
   addReportOptions(benchCommand, benchArguments.outDir, benchArguments.report, benchArguments.quiet);
 
   app.add_subcommand("scenes", "List the shipped scenes");
@@ -152,7 +153,16 @@ int main(int argc, char** argv) {
     if (*renderCommand) return render(renderArguments);
     if (*stabilityCommand) return stability(stabilityArguments);
     if (*studyCommand) return study(studyArguments);
-    if (*benchCommand) return bench(benchArguments);
+    if (*benchCommand) {
+      // --quick shrinks only what was not asked for explicitly.
+      if (benchArguments.quick) {
+        if (benchCommand->count("--sizes") == 0) benchArguments.sizes = {16, 24};
+        if (benchCommand->count("--frames") == 0) benchArguments.frames = 10;
+        if (benchCommand->count("--repeats") == 0) benchArguments.repeats = 1;
+        if (benchCommand->count("--naive-iterations") == 0) benchArguments.naiveIterations = {10};
+      }
+      return bench(benchArguments);
+    }
     return listScenes();
   } catch (const std::exception& error) {  // a bug, not bad input: say so rather than abort
     std::cerr << "drape-cli: internal error: " << error.what() << "\n";
