@@ -94,147 +94,197 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
   }
 }
 
-// A symmetric 3 x 3 matrix.
-struct Sym3 {
-  Real xx = 0.0, yy = 0.0, zz = 0.0, xy = 0.0, xz = 0.0, yz = 0.0;
-  Vec3 operator*(Vec3 u) const {
-    return {xx * u.x + xy * u.y + xz * u.z, xy * u.x + yy * u.y + yz * u.z, xz * u.x + yz * u.y + zz * u.z};
-  }
-  Sym3 operator+(const Sym3& o) const { return {xx + o.xx, yy + o.yy, zz + o.zz, xy + o.xy, xz + o.xz, yz + o.yz}; }
-  Sym3 operator*(Real a) const { return {xx * a, yy * a, zz * a, xy * a, xz * a, yz * a}; }
+// Two doubles side by side: two lines' arithmetic in one instruction (SSE2, the portable baseline).
+using Lane = double __attribute__((vector_size(16)));
+struct Lane3 {
+  Lane x, y, z;
 };
-Sym3 diagonal(Real a) { return {a, a, a, 0.0, 0.0, 0.0}; }
-Sym3 outer(Vec3 u) { return {u.x * u.x, u.y * u.y, u.z * u.z, u.x * u.y, u.x * u.z, u.y * u.z}; }
+struct LaneSym3 {
+  Lane xx, yy, zz, xy, xz, yz;
+};
+Lane load(const std::array<Real, 4>& a, std::size_t half) { return Lane{a[2 * half], a[2 * half + 1]}; }
+void keep(std::array<Real, 4>& a, std::size_t half, Lane v) {
+  a[2 * half] = v[0];
+  a[2 * half + 1] = v[1];
+}
+Lane3 load(const std::array<std::array<Real, 4>, 3>& a, std::size_t half) {
+  return {load(a[0], half), load(a[1], half), load(a[2], half)};
+}
+void keep(std::array<std::array<Real, 4>, 3>& a, std::size_t half, const Lane3& v) {
+  keep(a[0], half, v.x);
+  keep(a[1], half, v.y);
+  keep(a[2], half, v.z);
+}
+LaneSym3 load(const std::array<std::array<Real, 4>, 6>& a, std::size_t half) {
+  return {load(a[0], half), load(a[1], half), load(a[2], half), load(a[3], half), load(a[4], half), load(a[5], half)};
+}
+void keep(std::array<std::array<Real, 4>, 6>& a, std::size_t half, const LaneSym3& m) {
+  keep(a[0], half, m.xx);
+  keep(a[1], half, m.yy);
+  keep(a[2], half, m.zz);
+  keep(a[3], half, m.xy);
+  keep(a[4], half, m.xz);
+  keep(a[5], half, m.yz);
+}
+Lane3 operator+(const Lane3& a, const Lane3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Lane3 operator-(const Lane3& a, const Lane3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Lane3 operator*(const Lane3& a, Lane s) { return {a.x * s, a.y * s, a.z * s}; }
+Lane dot(const Lane3& a, const Lane3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Lane3 operator*(const LaneSym3& m, const Lane3& u) {
+  return {m.xx * u.x + m.xy * u.y + m.xz * u.z, m.xy * u.x + m.yy * u.y + m.yz * u.z,
+          m.xz * u.x + m.yz * u.y + m.zz * u.z};
+}
+LaneSym3 operator+(const LaneSym3& a, const LaneSym3& b) {
+  return {a.xx + b.xx, a.yy + b.yy, a.zz + b.zz, a.xy + b.xy, a.xz + b.xz, a.yz + b.yz};
+}
+LaneSym3 operator*(const LaneSym3& a, Lane s) { return {a.xx * s, a.yy * s, a.zz * s, a.xy * s, a.xz * s, a.yz * s}; }
+// s (I - u u^T)
+LaneSym3 across(const Lane3& u, Lane s) {
+  return {(1.0 - u.x * u.x) * s, (1.0 - u.y * u.y) * s, (1.0 - u.z * u.z) * s,
+          -u.x * u.y * s,        -u.x * u.z * s,        -u.y * u.z * s};
+}
+LaneSym3 outer(const Lane3& u) { return {u.x * u.x, u.y * u.y, u.z * u.z, u.x * u.y, u.x * u.z, u.y * u.z}; }
 // u v^T + v u^T
-Sym3 outer(Vec3 u, Vec3 v) {
+LaneSym3 outer(const Lane3& u, const Lane3& v) {
   return {2.0 * u.x * v.x,       2.0 * u.y * v.y,       2.0 * u.z * v.z,
           u.x * v.y + u.y * v.x, u.x * v.z + u.z * v.x, u.y * v.z + u.z * v.y};
 }
-Sym3 inverse(const Sym3& a) {
-  const Real cxx = a.yy * a.zz - a.yz * a.yz, cxy = a.xz * a.yz - a.xy * a.zz, cxz = a.xy * a.yz - a.xz * a.yy;
-  const Real inv = 1.0 / (a.xx * cxx + a.xy * cxy + a.xz * cxz);
+LaneSym3 inverse(const LaneSym3& a) {
+  const Lane cxx = a.yy * a.zz - a.yz * a.yz, cxy = a.xz * a.yz - a.xy * a.zz, cxz = a.xy * a.yz - a.xz * a.yy;
+  const Lane inv = 1.0 / (a.xx * cxx + a.xy * cxy + a.xz * cxz);
   return {cxx * inv, (a.xx * a.zz - a.xz * a.xz) * inv, (a.xx * a.yy - a.xy * a.xy) * inv, cxy * inv,
           cxz * inv, (a.xy * a.xz - a.xx * a.yz) * inv};
 }
 
-// One full Newton step of a line's projection from where its particles are now, geometric
-// stiffness included: with dx the particles' moves and l the links' multipliers,
-//   K dx - J^T l = 0,   J dx + alpha~ l = -(C + alpha~ lambda),
-//   K = M + sum_k G_k (on link k's two particles: [G, -G; -G, G]), G_k = g_k (I - n_k n_k^T),
-// g_k = the link's tension (times h^2, from the last substep) over its length. Without G this is
-// the tridiagonal solve above; with it a particle's sideways move drags its neighbours, as a taut
-// string's does. The unknowns are eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of
-// one particle and one link (a 4 x 4 block, its 3 x 3 part inverted), so a pinned particle (which
-// does not move: its unknowns drop out) never leaves a link's multiplier without a pivot.
+// The elimination of solveStiffLines for lanes 2 half and 2 half + 1 of rows[0, n), gathered. On
+// return each row's yx holds its particle's move and yl its link-before's multiplier.
+void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Real alphaTilde, std::size_t half) {
+  using Row = SolverScratch::StiffRows;
+  const auto direction = [half](const Row& r) { return Lane3{load(r.nx, half), load(r.ny, half), load(r.nz, half)}; };
+  const Lane zero{0.0, 0.0}, one{1.0, 1.0};
+  // Forward. P is the last node's (S^-1)_xx, zx its (S^-1 y)_x: what it passes on through the link.
+  LaneSym3 P;
+  Lane3 zx{zero, zero, zero};
+  {
+    Row& r = rows[0];
+    const LaneSym3 inverseA =
+        inverse(LaneSym3{load(r.mass, half), load(r.mass, half), load(r.mass, half), zero, zero, zero} +
+                across(direction(r), load(r.g, half))) *
+        load(r.moves, half);
+    keep(r.inverse, half, inverseA);
+    P = inverseA;
+    keep(r.v, half, zx);
+    keep(r.b, half, zx);
+    keep(r.yx, half, zx);
+    keep(r.schur, half, one);
+    keep(r.yl, half, zero);
+  }
+  for (std::size_t j = 1; j < n; ++j) {
+    const Row& link = rows[j - 1];  // joins particle j - 1 to j
+    Row& r = rows[j];
+    const Lane3 unit = direction(link);
+    const Lane pull = load(link.g, half), live = load(link.live, half);
+    const Lane3 Pn = P * unit;
+    const Lane nPn = dot(unit, Pn);
+    const Lane3 b = (Pn - unit * nPn) * pull - unit;
+    const Lane c = live * (-alphaTilde - nPn) + (1.0 - live);  // a dead link: the row of the identity
+    const Lane nz = dot(unit, zx);
+    const Lane3 yx = (zx - unit * nz) * pull;
+    Lane yl = live * (load(link.rhs, half) - nz);
+    // A = m I + G_{j-1} + G_j - G_{j-1} P G_{j-1}
+    const Lane m = load(r.mass, half);
+    const LaneSym3 A = LaneSym3{m, m, m, zero, zero, zero} + across(unit, pull) +
+                       across(direction(r), load(r.g, half)) +
+                       (P + outer(unit, Pn) * -one + outer(unit) * nPn) * (-pull * pull);
+    const LaneSym3 inverseA = inverse(A) * load(r.moves, half);
+    const Lane3 v = inverseA * b;
+    Lane schur = c - dot(b, v);
+    for (int lane = 0; lane < 2; ++lane) {
+      if (!(std::abs(schur[lane]) > 0.0)) {  // both particles held: the link cannot be corrected
+        schur[lane] = 1.0;
+        yl[lane] = 0.0;
+      }
+    }
+    schur = 1.0 / schur;
+    const Lane3 t = inverseA * yx;
+    const Lane zl = (yl - dot(b, t)) * schur;
+    zx = t - v * zl;
+    P = inverseA + outer(v) * schur;
+    keep(r.inverse, half, inverseA);
+    keep(r.v, half, v);
+    keep(r.b, half, b);
+    keep(r.yx, half, yx);
+    keep(r.schur, half, schur);
+    keep(r.yl, half, yl);
+  }
+
+  // Back: particle j's move and link j - 1's multiplier, from node j + 1's.
+  Lane3 ux{zero, zero, zero};
+  Lane ul = zero;
+  for (std::size_t j = n; j-- > 0;) {
+    Row& r = rows[j];
+    Lane3 px = load(r.yx, half);
+    if (j + 1 < n) {  // minus link j's coupling to node j + 1
+      const Lane3 unit = direction(r);
+      px = px + (ux - unit * dot(unit, ux)) * load(r.g, half) - unit * ul;
+    }
+    const Lane3 t = load(r.inverse, half) * px;
+    ul = j > 0 ? (load(r.yl, half) - dot(load(r.b, half), t)) * load(r.schur, half) : zero;
+    ux = t - load(r.v, half) * ul;
+    keep(r.yx, half, ux);
+    keep(r.yl, half, ul);
+  }
+}
+
 template <std::size_t G>
 void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                      const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
                      const std::array<const Real*, G>& tension, const std::array<Real*, G>& tensionSum, std::size_t n,
-                     Real stiffness, Real alphaTilde, SolverScratch::StiffRow* rows) {
+                     Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows) {
+  static_assert(G <= 4);
+  using Row = SolverScratch::StiffRows;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
-  const Real* m = s.mass.data();
+  const Real* mass = s.mass.data();
   const std::size_t links = n - 1;
-  // Row of particle (and link) k of line g.
-  const auto at = [&](std::size_t k, std::size_t g) -> SolverScratch::StiffRow& { return rows[k * G + g]; };
+  // Gathered first: each link's direction, value and geometric stiffness, each particle's mass.
   for (std::size_t k = 0; k < n; ++k) {
+    Row& r = rows[k];
     for (std::size_t g = 0; g < G; ++g) {
-      SolverScratch::StiffRow& r = at(k, g);
-      r.live = false;
-      r.n = Vec3{0.0};
-      r.g = r.rhs = 0.0;
+      r.mass[g] = mass[p[g][k]];
+      r.moves[g] = w[p[g][k]] > 0.0 ? 1.0 : 0.0;
+      r.nx[g] = r.ny[g] = r.nz[g] = r.g[g] = r.rhs[g] = r.live[g] = 0.0;
       if (k == links) continue;
       const Vec3 d = x[p[g][k + 1]] - x[p[g][k]];
       const Real length2 = glm::dot(d, d);
       if (!(length2 > 1e-20 && w[p[g][k]] + w[p[g][k + 1]] + alphaTilde > 0.0)) continue;
       const Real length = std::sqrt(length2);
-      r.live = true;
-      r.n = d * (1.0 / length);
-      r.rhs = (length - rest[g][k]) + (lambda[g] ? alphaTilde * lambda[g][k] : 0.0);
-      r.g = std::max(-tension[g][k], 0.0) / length;  // pulled links only: a pushed one would make K indefinite
+      const Vec3 unit = d * (1.0 / length);
+      r.nx[g] = unit.x;
+      r.ny[g] = unit.y;
+      r.nz[g] = unit.z;
+      r.live[g] = 1.0;
+      r.rhs[g] = (length - rest[g][k]) + (lambda[g] ? alphaTilde * lambda[g][k] : 0.0);
+      r.g[g] = std::max(-tension[g][k], 0.0) / length;  // pulled links only: a pushed one would make K indefinite
     }
   }
-  // G_k u, and G_k as a matrix.
-  const auto pull = [](const SolverScratch::StiffRow& link, Vec3 u) {
-    return (u - link.n * glm::dot(link.n, u)) * link.g;
-  };
-  const auto geometric = [](const SolverScratch::StiffRow& link) {
-    return (diagonal(1.0) + outer(link.n) * -1.0) * link.g;
-  };
-  const auto load = [](const SolverScratch::StiffRow& r) {
-    return Sym3{r.inverse[0], r.inverse[1], r.inverse[2], r.inverse[3], r.inverse[4], r.inverse[5]};
-  };
-  const auto store = [](SolverScratch::StiffRow& r, const Sym3& a) {
-    r.inverse = {a.xx, a.yy, a.zz, a.xy, a.xz, a.yz};
-  };
-
-  // Forward. P is the last node's (S^-1)_xx, zx its (S^-1 y)_x: what it passes on through the link.
-  std::array<Sym3, G> P;
-  std::array<Vec3, G> zx;
-  for (std::size_t g = 0; g < G; ++g) {
-    SolverScratch::StiffRow& r = at(0, g);
-    P[g] = w[p[g][0]] > 0.0 ? inverse(diagonal(m[p[g][0]]) + geometric(r)) : Sym3{};
-    zx[g] = Vec3{0.0};
-    store(r, P[g]);
-    r.v = r.b = r.yx = Vec3{0.0};
-    r.schur = 1.0;
-    r.yl = 0.0;
-  }
-  for (std::size_t j = 1; j < n; ++j) {
-    for (std::size_t g = 0; g < G; ++g) {
-      const SolverScratch::StiffRow& link = at(j - 1, g);  // joins particle j - 1 to j
-      SolverScratch::StiffRow& r = at(j, g);
-      const Vec3 Pn = P[g] * link.n;
-      const Real nPn = glm::dot(link.n, Pn);
-      r.b = pull(link, Pn) - link.n;
-      const Real c = link.live ? -alphaTilde - nPn : 1.0;
-      r.yx = pull(link, zx[g]);
-      r.yl = link.live ? link.rhs - glm::dot(link.n, zx[g]) : 0.0;
-      Sym3 inverseA;
-      if (w[p[g][j]] > 0.0) {
-        // A = m I + G_{j-1} + G_j - G_{j-1} P G_{j-1}
-        Sym3 A = diagonal(m[p[g][j]]);
-        if (link.g > 0.0) {
-          A = A + geometric(link) + (P[g] + outer(link.n, Pn) * -1.0 + outer(link.n) * nPn) * (-link.g * link.g);
-        }
-        if (r.g > 0.0) A = A + geometric(r);
-        inverseA = inverse(A);
-        r.v = inverseA * r.b;
-        r.schur = c - glm::dot(r.b, r.v);
-      } else {
-        r.v = Vec3{0.0};
-        r.schur = c;
-      }
-      store(r, inverseA);
-      // Both particles held: the link cannot be corrected.
-      if (!(std::abs(r.schur) > 0.0)) {
-        r.schur = 1.0;
-        r.yl = 0.0;
-      }
-      r.schur = 1.0 / r.schur;  // from here on, its inverse
-      const Vec3 t = inverseA * r.yx;
-      const Real zl = (r.yl - glm::dot(r.b, t)) * r.schur;
-      zx[g] = t - r.v * zl;
-      P[g] = inverseA + outer(r.v) * r.schur;
+  for (std::size_t k = 0; k < n; ++k) {  // lanes no line fills: a free particle, no link
+    for (std::size_t g = G; g < 4; ++g) {
+      Row& r = rows[k];
+      r.mass[g] = 1.0;
+      r.moves[g] = r.nx[g] = r.ny[g] = r.nz[g] = r.g[g] = r.rhs[g] = r.live[g] = 0.0;
     }
   }
-
-  // Back: particle j's move and link j - 1's multiplier, from node j + 1's.
-  std::array<Vec3, G> ux;
-  std::array<Real, G> ul{};
-  ux.fill(Vec3{0.0});
-  for (std::size_t j = n; j-- > 0;) {
+  // The four lanes in two pairs of vector registers; a held particle or a dead link is masked, not
+  // branched on.
+  for (std::size_t half = 0; half < 2; ++half) solveStiffLanes(rows, n, alphaTilde, half);
+  for (std::size_t j = 0; j < n; ++j) {
+    const Row& r = rows[j];
     for (std::size_t g = 0; g < G; ++g) {
-      const SolverScratch::StiffRow& r = at(j, g);
-      Vec3 px = r.yx;
-      if (j + 1 < n) px += pull(r, ux[g]) - r.n * ul[g];  // minus link j's coupling to node j + 1
-      const Vec3 t = load(r) * px;
-      ul[g] = j > 0 ? (r.yl - glm::dot(r.b, t)) * r.schur : 0.0;
-      ux[g] = t - r.v * ul[g];
-      if (w[p[g][j]] > 0.0) x[p[g][j]] += ux[g] * stiffness;
-      if (j > 0 && at(j - 1, g).live) {
-        if (lambda[g]) lambda[g][j - 1] += ul[g] * stiffness;
-        tensionSum[g][j - 1] += ul[g] * stiffness;
+      if (r.moves[g] != 0.0) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
+      if (j > 0 && rows[j - 1].live[g] != 0.0) {
+        if (lambda[g]) lambda[g][j - 1] += r.yl[g] * stiffness;
+        tensionSum[g][j - 1] += r.yl[g] * stiffness;
       }
     }
   }
@@ -344,7 +394,7 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
            Workers& workers, Real* looseLambda) {
   ParticleState& s = cloth.state;
   if (geometricStiffness) {
-    const std::size_t rows = scratch.lineStride * static_cast<std::size_t>(workers.threads());
+    const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
     for (SolverScratch::LineFamily& lines : scratch.lines) {
       lines.tension.resize(lines.rest.size(), 0.0);
@@ -380,7 +430,7 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
                        }
                        if (geometricStiffness && step == 0) {
                          solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                            scratch.lineStiff.data() + slice);
+                                            scratch.lineStiff.data() + slice / 4);
                        } else {
                          solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
                                        scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,

@@ -63,19 +63,21 @@ struct SolverScratch {
   std::size_t lineStride = 0;
   std::vector<Vec3> lineNormal;
   std::vector<Real> lineUpper, lineSolution;
-  // ... and of the line solve with geometric stiffness: one row per particle of a line.
-  struct StiffRow {
-    Vec3 n{0.0};                    // direction of the link to the next particle
-    Real g = 0.0;                   // its geometric stiffness: G = g (I - n n^T)
-    Real rhs = 0.0;                 // its constraint value, C + alpha~ lambda
-    bool live = false;              // a link the solve corrects
-    std::array<Real, 6> inverse{};  // A^-1 of the particle's eliminated block (symmetric)
-    Vec3 v{0.0}, b{0.0};
-    Real schur = 1.0;  // the link multiplier's pivot, then its inverse
-    Vec3 yx{0.0};
-    Real yl = 0.0;
+  // ... and of the line solve with geometric stiffness: per particle of four lines solved together,
+  // each quantity for the four lines side by side, so that the solve runs in vector lanes.
+  struct StiffRows {
+    using Lanes = std::array<Real, 4>;
+    Lanes nx, ny, nz;              // direction of the link to the next particle
+    Lanes g;                       // its geometric stiffness: G = g (I - n n^T)
+    Lanes rhs;                     // its constraint value, C + alpha~ lambda
+    Lanes live;                    // 1: a link the solve corrects; 0: not
+    Lanes mass, moves;             // the particle's mass, and 1 if it is free to move
+    std::array<Lanes, 6> inverse;  // A^-1 of its eliminated block (symmetric: xx yy zz xy xz yz)
+    std::array<Lanes, 3> v, b, yx;
+    Lanes schur;  // the inverse of the link multiplier's pivot
+    Lanes yl;
   };
-  std::vector<StiffRow> lineStiff;
+  std::vector<StiffRows> lineStiff;
   // Each kind's constraints come in batches that share no particle (batches.hpp): batch b is
   // [batchStart[b], batchStart[b + 1]); with sequentialTail the last batch is not one.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;
