@@ -18,6 +18,7 @@
 #include "common.hpp"
 #include "drape/analysis/analytic.hpp"
 #include "drape/analysis/convergence.hpp"
+#include "drape/bench/measure.hpp"
 #include "drape/scene/error.hpp"
 #include "drape/scene/gesture.hpp"
 #include "drape/scene/output.hpp"
@@ -161,9 +162,8 @@ int study(const StudyArguments& arguments) {
         run = simulate(configured, steps, arguments.gesture);
         times.push_back(run.cpuSecondsPerSimulatedSecond);
       }
-      std::sort(times.begin(), times.end());
       // A run that diverged has no time or strain worth comparing.
-      rows.push_back({label.empty() ? "scene as written" : label, run.diverged ? NAN : times[times.size() / 2],
+      rows.push_back({label.empty() ? "scene as written" : label, run.diverged ? NAN : bench::median(times),
                       run.diverged ? NAN : run.strainMax, run.diverged ? NAN : run.strainMean,
                       run.diverged || arguments.noReference ? NAN : rmsDistance(run, reference), run.diverged});
       std::size_t s = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "drape/bench/naive.hpp"
 #include "drape/sim/metrics.hpp"
@@ -13,12 +14,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kBudgetSeconds = 20.0;  // no further repeats once a case has taken this long
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 void timing(Measurement& m, const std::vector<double>& seconds, double projectionsPerFrame) {
   const double perFrame = median(seconds) / m.frames;
@@ -112,6 +107,13 @@ Measurement measureNaive(const sim::WorldSettings& settings, int frames, int ite
   }
   timing(m, seconds, static_cast<double>(iterations) * static_cast<double>(m.constraints));
   return m;
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  if (n == 0) return NAN;
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 }  // namespace drape::bench

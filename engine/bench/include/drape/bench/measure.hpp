@@ -41,4 +41,7 @@ Measurement measureWorld(const sim::WorldSettings& world, int frames, int thread
 // The naive baseline (naive.hpp) on the world's first cloth.
 Measurement measureNaive(const sim::WorldSettings& world, int frames, int iterations, int repeats);
 
+// The middle value, or the mean of the two middle ones; NaN for none.
+double median(std::vector<double> values);
+
 }  // namespace drape::bench
