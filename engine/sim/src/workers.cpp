@@ -32,8 +32,8 @@ Workers::Workers(int threads) {
 
 Workers::~Workers() {
   stop_.store(true, std::memory_order_release);
-  generation_.fetch_add(1, std::memory_order_release);
-  generation_.notify_all();
+  state_.store((state_.load(std::memory_order_relaxed) / kStateParts + 1) * kStateParts, std::memory_order_release);
+  state_.notify_all();
   for (std::thread& helper : helpers_) helper.join();
 }
 
@@ -47,10 +47,10 @@ void Workers::dispatch(std::size_t n, std::size_t grain, Call call, void* task) 
   call_ = call;
   task_ = task;
   items_ = n;
-  active_ = parts;
-  pending_.store(static_cast<int>(helpers_.size()), std::memory_order_relaxed);
-  generation_.fetch_add(1, std::memory_order_release);
-  generation_.notify_all();
+  pending_.store(parts - 1, std::memory_order_relaxed);
+  const std::uint64_t loop = state_.load(std::memory_order_relaxed) / kStateParts + 1;
+  state_.store(loop * kStateParts + static_cast<std::uint64_t>(parts), std::memory_order_release);
+  state_.notify_all();
   const auto [begin, end] = chunk(n, parts, 0);
   call(task, begin, end, 0);
   for (int round = 0; pending_.load(std::memory_order_acquire) != 0; ++round) pause(round);
@@ -60,21 +60,22 @@ void Workers::dispatch(std::size_t n, std::size_t grain, Call call, void* task) 
 void Workers::loop(int index) {
   std::uint64_t seen = 0;
   while (true) {
-    std::uint64_t now = generation_.load(std::memory_order_acquire);
+    std::uint64_t now = state_.load(std::memory_order_acquire);
     for (int spin = 0; now == seen && spin < kSpins; ++spin) {
       pause(spin);
-      now = generation_.load(std::memory_order_acquire);
+      now = state_.load(std::memory_order_acquire);
     }
     if (now == seen) {
-      generation_.wait(seen, std::memory_order_acquire);
+      state_.wait(seen, std::memory_order_acquire);
       continue;
     }
     seen = now;
     if (stop_.load(std::memory_order_acquire)) return;
-    if (index < active_) {
-      const auto [begin, end] = chunk(items_, active_, index);
-      call_(task_, begin, end, index);
-    }
+    // Not taking part: nothing of the loop is read (the caller may already be setting up the next).
+    const int parts = static_cast<int>(now % kStateParts);
+    if (index >= parts) continue;
+    const auto [begin, end] = chunk(items_, parts, index);
+    call_(task_, begin, end, index);
     pending_.fetch_sub(1, std::memory_order_acq_rel);
   }
 }

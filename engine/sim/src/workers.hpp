@@ -4,7 +4,8 @@
 // each (chunk 0 on the caller) and returns when all are done. The solver only hands it work whose
 // items are independent (a batch of constraints no two of which share a particle, lines, single
 // particles), so the result is the same bit for bit whatever the number of threads. Helpers spin
-// briefly between loops (a substep has a dozen of them), then sleep.
+// briefly between loops (a substep has a dozen of them), then sleep. A loop cut into fewer parts
+// than there are threads waits only for the helpers it uses.
 #pragma once
 
 #include <atomic>
@@ -42,12 +43,16 @@ class Workers {
   void dispatch(std::size_t n, std::size_t grain, Call call, void* task);
   void loop(int index);
   std::vector<std::thread> helpers_;
+  // The current loop. Written only while no helper uses them: before a loop is announced, and after
+  // every helper taking part has said it is done.
   Call call_ = nullptr;
   void* task_ = nullptr;
   std::size_t items_ = 0;
-  int active_ = 1;  // threads taking part in the current loop
-  std::atomic<std::uint64_t> generation_{0};
-  std::atomic<int> pending_{0};
+  // The loop's number times kStateParts, plus the threads taking part in it (the caller and helpers
+  // 1 .. parts - 1): one word, so a helper never pairs one loop's number with another's parts.
+  static constexpr std::uint64_t kStateParts = 128;
+  std::atomic<std::uint64_t> state_{0};
+  std::atomic<int> pending_{0};  // helpers taking part that have not finished
   std::atomic<bool> stop_{false};
 };
 
