@@ -255,6 +255,31 @@ TEST(Workers, LoopsOfFewerPartsThanThreadsUseOnlyTheirHelpers) {
   EXPECT_EQ(total, 1000LL * 8 * (2 + 3 + 8 + 1));
 }
 
+TEST(Workers, APartThatThrowsReachesTheCallerAndThePoolCarriesOn) {
+  Workers workers(3);
+  for (const int thrower : {0, 1, 2}) {  // the caller's part, then each helper's
+    std::atomic<int> finished{0};
+    EXPECT_THROW(workers.run(
+                     30,
+                     [&](std::size_t, std::size_t, int thread) {
+                       if (thread == thrower) throw std::runtime_error("part failed");
+                       finished.fetch_add(1);
+                     },
+                     10),
+                 std::runtime_error)
+        << "thrower " << thrower;
+    EXPECT_EQ(finished.load(), 2) << "the other parts ran to the end first";
+  }
+  std::vector<int> visits(30, 0);
+  workers.run(
+      30,
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t i = begin; i < end; ++i) ++visits[i];
+      },
+      10);
+  EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), 30);
+}
+
 // ---- lens tethers ----------------------------------------------------------------------------
 
 // A single free particle tethered to two pins.

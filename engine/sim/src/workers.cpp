@@ -52,9 +52,21 @@ void Workers::dispatch(std::size_t n, std::size_t grain, Call call, void* task) 
   state_.store(loop * kStateParts + static_cast<std::uint64_t>(parts), std::memory_order_release);
   state_.notify_all();
   const auto [begin, end] = chunk(n, parts, 0);
-  call(task, begin, end, 0);
+  std::exception_ptr failure;
+  try {
+    call(task, begin, end, 0);
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  // Even when this part failed, the helpers are still using the task: wait for them.
   for (int round = 0; pending_.load(std::memory_order_acquire) != 0; ++round) pause(round);
   task_ = nullptr;
+  {
+    const std::lock_guard<std::mutex> lock(failureMutex_);
+    if (!failure) failure = failure_;
+    failure_ = nullptr;
+  }
+  if (failure) std::rethrow_exception(failure);
 }
 
 void Workers::loop(int index) {
@@ -75,7 +87,12 @@ void Workers::loop(int index) {
     const int parts = static_cast<int>(now % kStateParts);
     if (index >= parts) continue;
     const auto [begin, end] = chunk(items_, parts, index);
-    call_(task_, begin, end, index);
+    try {
+      call_(task_, begin, end, index);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failureMutex_);
+      if (!failure_) failure_ = std::current_exception();
+    }
     pending_.fetch_sub(1, std::memory_order_acq_rel);
   }
 }

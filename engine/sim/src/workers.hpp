@@ -5,12 +5,16 @@
 // items are independent (a batch of constraints no two of which share a particle, lines, single
 // particles), so the result is the same bit for bit whatever the number of threads. Helpers spin
 // briefly between loops (a substep has a dozen of them), then sleep. A loop cut into fewer parts
-// than there are threads waits only for the helpers it uses.
+// than there are threads waits only for the helpers it uses. If a part throws (say, bad_alloc), the
+// loop still waits for every part, then rethrows the first exception on the caller's thread; the
+// pool stays usable.
 #pragma once
 
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
+#include <mutex>
 #include <thread>
 #include <type_traits>
 #include <vector>
@@ -53,6 +57,8 @@ class Workers {
   static constexpr std::uint64_t kStateParts = 128;
   std::atomic<std::uint64_t> state_{0};
   std::atomic<int> pending_{0};  // helpers taking part that have not finished
+  std::mutex failureMutex_;
+  std::exception_ptr failure_;  // the first exception a helper's part threw in the current loop
   std::atomic<bool> stop_{false};
 };
 
