@@ -197,8 +197,9 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
   for (std::size_t k = 0; k < n; ++k) ++scratch.start[hashOf(scratch.cell[k]) + 1];
   for (std::size_t k = 0; k < tableSize; ++k) scratch.start[k + 1] += scratch.start[k];
   scratch.fill.assign(scratch.start.begin(), scratch.start.end() - 1);
-  for (std::size_t k = 0; k < n; ++k)
+  for (std::size_t k = 0; k < n; ++k) {
     scratch.entries[scratch.fill[hashOf(scratch.cell[k])]++] = static_cast<std::uint32_t>(k);
+  }
 
   scratch.pairs.resize(static_cast<std::size_t>(workers.threads()));
   for (std::vector<SelfCollisionScratch::Pair>& pairs : scratch.pairs) pairs.clear();

@@ -236,6 +236,17 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Real alphaTi
   }
 }
 
+// One full Newton step of G lines' projections from where their particles are now, geometric
+// stiffness included: with dx the particles' moves and l the links' multipliers,
+//   K dx - J^T l = 0,   J dx + alpha~ l = -(C + alpha~ lambda),
+//   K = M + sum_k G_k (on link k's two particles: [G, -G; -G, G]), G_k = g_k (I - n_k n_k^T),
+// g_k = the link's tension (times h^2, from the last substep) over its length (Tournier et al.
+// 2015, Andrews et al. 2017). Without G this is solveLines' tridiagonal system; with it a
+// particle's sideways move drags its neighbours, as a taut string's does. The unknowns are
+// eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
+// 3 x 3 inverse and a scalar pivot), so a held particle (whose unknowns drop out) never leaves a
+// link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
+// solved by solveStiffLanes two lines at a time, and the moves and multipliers scattered back.
 template <std::size_t G>
 void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                      const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
@@ -268,16 +279,18 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
       r.g[g] = std::max(-tension[g][k], 0.0) / length;  // pulled links only: a pushed one would make K indefinite
     }
   }
-  for (std::size_t k = 0; k < n; ++k) {  // lanes no line fills: a free particle, no link
-    for (std::size_t g = G; g < 4; ++g) {
+  // Only the pairs of lanes that hold lines are solved; a lane of such a pair that no line fills
+  // holds a free particle and no link.
+  constexpr std::size_t halves = (G + 1) / 2;
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t g = G; g < 2 * halves; ++g) {
       Row& r = rows[k];
       r.mass[g] = 1.0;
       r.moves[g] = r.nx[g] = r.ny[g] = r.nz[g] = r.g[g] = r.rhs[g] = r.live[g] = 0.0;
     }
   }
-  // The four lanes in two pairs of vector registers; a held particle or a dead link is masked, not
-  // branched on.
-  for (std::size_t half = 0; half < 2; ++half) solveStiffLanes(rows, n, alphaTilde, half);
+  // A held particle or a dead link is masked, not branched on.
+  for (std::size_t half = 0; half < halves; ++half) solveStiffLanes(rows, n, alphaTilde, half);
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
     for (std::size_t g = 0; g < G; ++g) {
@@ -390,13 +403,20 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
   scratch.lineSolution.assign(slices, 0.0);
 }
 
+void beginSubstep(SolverScratch& scratch) {
+  for (SolverScratch::LineFamily& lines : scratch.lines) {
+    lines.tension.swap(lines.tensionSum);
+    std::fill(lines.tensionSum.begin(), lines.tensionSum.end(), 0.0);
+  }
+}
+
 void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
            Workers& workers, Real* looseLambda) {
   ParticleState& s = cloth.state;
   if (geometricStiffness) {
     const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
-    for (SolverScratch::LineFamily& lines : scratch.lines) {
+    for (SolverScratch::LineFamily& lines : scratch.lines) {  // sized here alone (zero: no tension yet)
       lines.tension.resize(lines.rest.size(), 0.0);
       lines.tensionSum.resize(lines.rest.size(), 0.0);
     }

@@ -29,8 +29,12 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads);
 // like the cloth's stretch constraints).
 // With `geometricStiffness` each line's solve is a full Newton step, the links' geometric
 // stiffness from the tension they carried over the last substep (scratch.lines[f].tension) included;
-// each solve adds its multipliers to tensionSum (position_model.cpp moves it to tension each substep).
+// each solve adds its multipliers to tensionSum.
 void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
            Workers& workers, Real* looseLambda);
+
+// At the start of a substep with geometric stiffness: the multipliers the last substep's solves
+// added up become the tension this one's use, and the sums start again from zero.
+void beginSubstep(SolverScratch& scratch);
 
 }  // namespace drape::sim::lines

@@ -277,14 +277,7 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
       for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.rest.size(), 0.0);
     }
   }
-  if (solver.lines && solver.geometricStiffness) {
-    // The multipliers this substep's line solves add up become the tension the next one's use.
-    for (SolverScratch::LineFamily& family : scratch.lines) {
-      family.tension.swap(family.tensionSum);
-      family.tension.resize(family.rest.size(), 0.0);
-      family.tensionSum.assign(family.rest.size(), 0.0);
-    }
-  }
+  if (solver.lines && solver.geometricStiffness) lines::beginSubstep(scratch);
   for (int iteration = 0; iteration < solver.iterations; ++iteration) {
     if (solver.lines) {
       sweepInBatches(cloth, solver, h, scratch, workers);

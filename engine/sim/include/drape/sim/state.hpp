@@ -97,7 +97,7 @@ struct SelfCollisionScratch {
   std::vector<Owner> owner;        // hash entry -> particle
   std::vector<glm::u64vec3> cell;  // of each entry, when the hash was built
   std::vector<std::uint32_t> start, fill, entries;
-  std::vector<std::vector<Pair>> pairs;  // pairs within reach, one list per thread
+  std::vector<std::vector<Pair>> pairs;  // pairs in neighbouring cells, one list per thread
 };
 
 }  // namespace drape::sim
