@@ -2,9 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <type_traits>
+
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 #include <glm/geometric.hpp>
 
@@ -94,42 +100,58 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
   }
 }
 
-// Two doubles side by side: two lines' arithmetic in one instruction (SSE2, the portable baseline).
-using Lane = double __attribute__((vector_size(16)));
+// Four floats side by side: four lines' arithmetic in one instruction (SSE, the portable baseline).
+// The full Newton step runs in single precision: it only has to find the direction the second,
+// double-precision step refines (the links' lengths it leaves are that step's to correct).
+using Lane = float __attribute__((vector_size(16)));
+using Lanes = SolverScratch::StiffRows::Lanes;
 struct Lane3 {
   Lane x, y, z;
 };
 struct LaneSym3 {
   Lane xx, yy, zz, xy, xz, yz;
 };
-Lane load(const std::array<Real, 4>& a, std::size_t half) { return Lane{a[2 * half], a[2 * half + 1]}; }
-void keep(std::array<Real, 4>& a, std::size_t half, Lane v) {
-  a[2 * half] = v[0];
-  a[2 * half + 1] = v[1];
+Lane load(const Lanes& a) {
+  Lane v;
+  std::memcpy(&v, a.data(), sizeof v);
+  return v;
 }
-Lane3 load(const std::array<std::array<Real, 4>, 3>& a, std::size_t half) {
-  return {load(a[0], half), load(a[1], half), load(a[2], half)};
+void keep(Lanes& a, Lane v) { std::memcpy(a.data(), &v, sizeof v); }
+Lane3 load(const std::array<Lanes, 3>& a) { return {load(a[0]), load(a[1]), load(a[2])}; }
+void keep(std::array<Lanes, 3>& a, const Lane3& v) {
+  keep(a[0], v.x);
+  keep(a[1], v.y);
+  keep(a[2], v.z);
 }
-void keep(std::array<std::array<Real, 4>, 3>& a, std::size_t half, const Lane3& v) {
-  keep(a[0], half, v.x);
-  keep(a[1], half, v.y);
-  keep(a[2], half, v.z);
+LaneSym3 load(const std::array<Lanes, 6>& a) {
+  return {load(a[0]), load(a[1]), load(a[2]), load(a[3]), load(a[4]), load(a[5])};
 }
-LaneSym3 load(const std::array<std::array<Real, 4>, 6>& a, std::size_t half) {
-  return {load(a[0], half), load(a[1], half), load(a[2], half), load(a[3], half), load(a[4], half), load(a[5], half)};
-}
-void keep(std::array<std::array<Real, 4>, 6>& a, std::size_t half, const LaneSym3& m) {
-  keep(a[0], half, m.xx);
-  keep(a[1], half, m.yy);
-  keep(a[2], half, m.zz);
-  keep(a[3], half, m.xy);
-  keep(a[4], half, m.xz);
-  keep(a[5], half, m.yz);
+void keep(std::array<Lanes, 6>& a, const LaneSym3& m) {
+  keep(a[0], m.xx);
+  keep(a[1], m.yy);
+  keep(a[2], m.zz);
+  keep(a[3], m.xy);
+  keep(a[4], m.xz);
+  keep(a[5], m.yz);
 }
 Lane3 operator+(const Lane3& a, const Lane3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 Lane3 operator-(const Lane3& a, const Lane3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 Lane3 operator*(const Lane3& a, Lane s) { return {a.x * s, a.y * s, a.z * s}; }
 Lane dot(const Lane3& a, const Lane3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+using Mask = std::int32_t __attribute__((vector_size(16)));
+// 1 in the lanes a comparison holds in, else 0.
+Lane ones(Mask holds) {
+  const Lane one = Lane{} + 1.0f;
+  return std::bit_cast<Lane>(holds & std::bit_cast<Mask>(one));
+}
+Lane squareRoot(Lane a) {
+#if defined(__SSE__)
+  return _mm_sqrt_ps(a);
+#else
+  for (int lane = 0; lane < 4; ++lane) a[lane] = std::sqrt(a[lane]);
+  return a;
+#endif
+}
 Lane3 operator*(const LaneSym3& m, const Lane3& u) {
   return {m.xx * u.x + m.xy * u.y + m.xz * u.z, m.xy * u.x + m.yy * u.y + m.yz * u.z,
           m.xz * u.x + m.yz * u.y + m.zz * u.z};
@@ -140,82 +162,110 @@ LaneSym3 operator+(const LaneSym3& a, const LaneSym3& b) {
 LaneSym3 operator*(const LaneSym3& a, Lane s) { return {a.xx * s, a.yy * s, a.zz * s, a.xy * s, a.xz * s, a.yz * s}; }
 // s (I - u u^T)
 LaneSym3 across(const Lane3& u, Lane s) {
-  return {(1.0 - u.x * u.x) * s, (1.0 - u.y * u.y) * s, (1.0 - u.z * u.z) * s,
-          -u.x * u.y * s,        -u.x * u.z * s,        -u.y * u.z * s};
+  return {(1.0f - u.x * u.x) * s, (1.0f - u.y * u.y) * s, (1.0f - u.z * u.z) * s,
+          -u.x * u.y * s,         -u.x * u.z * s,         -u.y * u.z * s};
 }
 LaneSym3 outer(const Lane3& u) { return {u.x * u.x, u.y * u.y, u.z * u.z, u.x * u.y, u.x * u.z, u.y * u.z}; }
 // u v^T + v u^T
 LaneSym3 outer(const Lane3& u, const Lane3& v) {
-  return {2.0 * u.x * v.x,       2.0 * u.y * v.y,       2.0 * u.z * v.z,
+  return {2.0f * u.x * v.x,      2.0f * u.y * v.y,      2.0f * u.z * v.z,
           u.x * v.y + u.y * v.x, u.x * v.z + u.z * v.x, u.y * v.z + u.z * v.y};
 }
-LaneSym3 inverse(const LaneSym3& a) {
+[[gnu::always_inline]] inline LaneSym3 inverse(const LaneSym3& a) {
   const Lane cxx = a.yy * a.zz - a.yz * a.yz, cxy = a.xz * a.yz - a.xy * a.zz, cxz = a.xy * a.yz - a.xz * a.yy;
-  const Lane inv = 1.0 / (a.xx * cxx + a.xy * cxy + a.xz * cxz);
+  const Lane inv = 1.0f / (a.xx * cxx + a.xy * cxy + a.xz * cxz);
   return {cxx * inv, (a.xx * a.zz - a.xz * a.xz) * inv, (a.xx * a.yy - a.xy * a.xy) * inv, cxy * inv,
           cxz * inv, (a.xy * a.xz - a.xx * a.yz) * inv};
 }
 
-// The elimination of solveStiffLines for lanes 2 half and 2 half + 1 of rows[0, n), gathered. On
-// return each row's yx holds its particle's move and yl its link-before's multiplier.
-void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Real alphaTilde, std::size_t half) {
+// The elimination of solveStiffLines for the four lanes of rows[0, n), gathered. On return each
+// row's yx holds its particle's move and yl its link-before's multiplier.
+// A link as the solve uses it: its direction, geometric stiffness g, value C + alpha~ lambda, and 1
+// if the solve corrects it (else 0).
+struct Link {
+  Lane3 unit;
+  Lane pull, rhs, live;
+};
+
+// Link j from what solveStiffLines gathered into row j: the difference of its particles (in nx, ny,
+// nz), its rest length less alpha~ lambda (rhs), its tension over the unit mass (g) and 1 if
+// anything can move it (live). A link with no direction is dead. Keeps in the row what the back
+// substitution and the scatter read again: the direction, g and live.
+Link normalise(SolverScratch::StiffRows& r) {
+  const Lane3 d{load(r.nx), load(r.ny), load(r.nz)};
+  const Lane length2 = dot(d, d);
+  const Lane live = load(r.live) * ones(length2 > 1e-20f);
+  const Lane length = squareRoot(length2 * live + (1.0f - live));  // 1 where dead
+  const Lane inverseLength = live / length;
+  const Link link{d * inverseLength, load(r.g) * inverseLength, (length - load(r.rhs)) * live, live};
+  keep(r.nx, link.unit.x);
+  keep(r.ny, link.unit.y);
+  keep(r.nz, link.unit.z);
+  keep(r.g, link.pull);
+  keep(r.live, live);
+  return link;
+}
+
+// The elimination of solveStiffLines for the four lanes of rows[0, n), gathered. On return each
+// row's yx holds its particle's move and yl its link-before's multiplier.
+void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTilde) {
   using Row = SolverScratch::StiffRows;
-  const auto direction = [half](const Row& r) { return Lane3{load(r.nx, half), load(r.ny, half), load(r.nz, half)}; };
-  const Lane zero{0.0, 0.0}, one{1.0, 1.0};
+  const auto direction = [](const Row& r) { return Lane3{load(r.nx), load(r.ny), load(r.nz)}; };
+  const Lane zero{}, one = zero + 1.0f;
   // Forward. P is the last node's (S^-1)_xx, zx its (S^-1 y)_x: what it passes on through the link.
   LaneSym3 P;
   Lane3 zx{zero, zero, zero};
+  Link next = normalise(rows[0]);
   {
     Row& r = rows[0];
+    const Lane m = load(r.mass);
     const LaneSym3 inverseA =
-        inverse(LaneSym3{load(r.mass, half), load(r.mass, half), load(r.mass, half), zero, zero, zero} +
-                across(direction(r), load(r.g, half))) *
-        load(r.moves, half);
-    keep(r.inverse, half, inverseA);
+        inverse(LaneSym3{m, m, m, zero, zero, zero} + across(next.unit, next.pull)) * load(r.moves);
+    keep(r.inverse, inverseA);
     P = inverseA;
-    keep(r.v, half, zx);
-    keep(r.b, half, zx);
-    keep(r.yx, half, zx);
-    keep(r.schur, half, one);
-    keep(r.yl, half, zero);
+    keep(r.v, zx);
+    keep(r.b, zx);
+    keep(r.yx, zx);
+    keep(r.schur, one);
+    keep(r.yl, zero);
   }
   for (std::size_t j = 1; j < n; ++j) {
-    const Row& link = rows[j - 1];  // joins particle j - 1 to j
+    const Link link = next;  // joins particle j - 1 to j
     Row& r = rows[j];
-    const Lane3 unit = direction(link);
-    const Lane pull = load(link.g, half), live = load(link.live, half);
+    next = normalise(r);
+    const Lane3 unit = link.unit;
+    const Lane pull = link.pull, live = link.live;
     const Lane3 Pn = P * unit;
     const Lane nPn = dot(unit, Pn);
     const Lane3 b = (Pn - unit * nPn) * pull - unit;
-    const Lane c = live * (-alphaTilde - nPn) + (1.0 - live);  // a dead link: the row of the identity
+    const Lane c = live * (-alphaTilde - nPn) + (1.0f - live);  // a dead link: the row of the identity
     const Lane nz = dot(unit, zx);
     const Lane3 yx = (zx - unit * nz) * pull;
-    Lane yl = live * (load(link.rhs, half) - nz);
+    Lane yl = live * (link.rhs - nz);
     // A = m I + G_{j-1} + G_j - G_{j-1} P G_{j-1}
-    const Lane m = load(r.mass, half);
-    const LaneSym3 A = LaneSym3{m, m, m, zero, zero, zero} + across(unit, pull) +
-                       across(direction(r), load(r.g, half)) +
+    const Lane m = load(r.mass);
+    const LaneSym3 A = LaneSym3{m, m, m, zero, zero, zero} + across(unit, pull) + across(next.unit, next.pull) +
                        (P + outer(unit, Pn) * -one + outer(unit) * nPn) * (-pull * pull);
-    const LaneSym3 inverseA = inverse(A) * load(r.moves, half);
+    const LaneSym3 inverseA = inverse(A) * load(r.moves);
     const Lane3 v = inverseA * b;
     Lane schur = c - dot(b, v);
-    for (int lane = 0; lane < 2; ++lane) {
-      if (!(std::abs(schur[lane]) > 0.0)) {  // both particles held: the link cannot be corrected
-        schur[lane] = 1.0;
-        yl[lane] = 0.0;
+    for (int lane = 0; lane < 4; ++lane) {
+      if (!(std::abs(schur[lane]) > 0.0f)) {  // both particles held: the link cannot be corrected
+        schur[lane] = 1.0f;
+        yl[lane] = 0.0f;
       }
     }
-    schur = 1.0 / schur;
+    schur = 1.0f / schur;
     const Lane3 t = inverseA * yx;
     const Lane zl = (yl - dot(b, t)) * schur;
     zx = t - v * zl;
     P = inverseA + outer(v) * schur;
-    keep(r.inverse, half, inverseA);
-    keep(r.v, half, v);
-    keep(r.b, half, b);
-    keep(r.yx, half, yx);
-    keep(r.schur, half, schur);
-    keep(r.yl, half, yl);
+    keep(r.inverse, inverseA);
+    keep(r.v, v);
+    keep(r.b, b);
+    keep(r.yx, yx);
+    keep(r.schur, schur);
+    keep(r.yl, yl);
   }
 
   // Back: particle j's move and link j - 1's multiplier, from node j + 1's.
@@ -223,16 +273,16 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Real alphaTi
   Lane ul = zero;
   for (std::size_t j = n; j-- > 0;) {
     Row& r = rows[j];
-    Lane3 px = load(r.yx, half);
+    Lane3 px = load(r.yx);
     if (j + 1 < n) {  // minus link j's coupling to node j + 1
       const Lane3 unit = direction(r);
-      px = px + (ux - unit * dot(unit, ux)) * load(r.g, half) - unit * ul;
+      px = px + (ux - unit * dot(unit, ux)) * load(r.g) - unit * ul;
     }
-    const Lane3 t = load(r.inverse, half) * px;
-    ul = j > 0 ? (load(r.yl, half) - dot(load(r.b, half), t)) * load(r.schur, half) : zero;
-    ux = t - load(r.v, half) * ul;
-    keep(r.yx, half, ux);
-    keep(r.yl, half, ul);
+    const Lane3 t = load(r.inverse) * px;
+    ul = j > 0 ? (load(r.yl) - dot(load(r.b), t)) * load(r.schur) : zero;
+    ux = t - load(r.v) * ul;
+    keep(r.yx, ux);
+    keep(r.yl, ul);
   }
 }
 
@@ -246,7 +296,7 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Real alphaTi
 // eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
 // 3 x 3 inverse and a scalar pivot), so a held particle (whose unknowns drop out) never leaves a
 // link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
-// solved by solveStiffLanes two lines at a time, and the moves and multipliers scattered back.
+// solved by solveStiffLanes four lines at once, and the moves and multipliers scattered back.
 template <std::size_t G>
 void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                      const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
@@ -259,45 +309,46 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   const Real* mass = s.mass.data();
   const std::size_t links = n - 1;
   // Gathered first: each link's direction, value and geometric stiffness, each particle's mass.
+  // Each line's system is solved in units of its first particle's mass (K / s, alpha~ s, l / s,
+  // s = that mass), so that single precision holds whatever the cloth weighs.
+  std::array<Real, 4> unitMass{1.0, 1.0, 1.0, 1.0};
+  Lanes alpha{};
+  for (std::size_t g = 0; g < G; ++g) {
+    unitMass[g] = mass[p[g][0]] > 0.0 ? mass[p[g][0]] : 1.0;
+    alpha[g] = static_cast<float>(alphaTilde * unitMass[g]);
+  }
   for (std::size_t k = 0; k < n; ++k) {
     Row& r = rows[k];
-    for (std::size_t g = 0; g < G; ++g) {
-      r.mass[g] = mass[p[g][k]];
-      r.moves[g] = w[p[g][k]] > 0.0 ? 1.0 : 0.0;
-      r.nx[g] = r.ny[g] = r.nz[g] = r.g[g] = r.rhs[g] = r.live[g] = 0.0;
-      if (k == links) continue;
+    // Each link's difference (in double: the particles' distance from the origin may be a thousand
+    // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
+    // the link's direction, value and geometric stiffness (normalise). Lanes no line fills hold a
+    // free particle and no link.
+    for (std::size_t g = 0; g < 4; ++g) {
+      r.mass[g] = g < G ? static_cast<float>(mass[p[g][k]] / unitMass[g]) : 1.0f;
+      r.moves[g] = g < G && w[p[g][k]] > 0.0 ? 1.0f : 0.0f;
+      r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
+      if (g >= G || k == links) continue;
       const Vec3 d = x[p[g][k + 1]] - x[p[g][k]];
-      const Real length2 = glm::dot(d, d);
-      if (!(length2 > 1e-20 && w[p[g][k]] + w[p[g][k + 1]] + alphaTilde > 0.0)) continue;
-      const Real length = std::sqrt(length2);
-      const Vec3 unit = d * (1.0 / length);
-      r.nx[g] = unit.x;
-      r.ny[g] = unit.y;
-      r.nz[g] = unit.z;
-      r.live[g] = 1.0;
-      r.rhs[g] = (length - rest[g][k]) + (lambda[g] ? alphaTilde * lambda[g][k] : 0.0);
-      r.g[g] = std::max(-tension[g][k], 0.0) / length;  // pulled links only: a pushed one would make K indefinite
-    }
-  }
-  // Only the pairs of lanes that hold lines are solved; a lane of such a pair that no line fills
-  // holds a free particle and no link.
-  constexpr std::size_t halves = (G + 1) / 2;
-  for (std::size_t k = 0; k < n; ++k) {
-    for (std::size_t g = G; g < 2 * halves; ++g) {
-      Row& r = rows[k];
-      r.mass[g] = 1.0;
-      r.moves[g] = r.nx[g] = r.ny[g] = r.nz[g] = r.g[g] = r.rhs[g] = r.live[g] = 0.0;
+      r.nx[g] = static_cast<float>(d.x);
+      r.ny[g] = static_cast<float>(d.y);
+      r.nz[g] = static_cast<float>(d.z);
+      // C + alpha~ lambda = length - (rest - alpha~ lambda)
+      r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
+      // Pulled links only: a pushed one would make K indefinite.
+      r.g[g] = static_cast<float>(std::max(-tension[g][k], 0.0) / unitMass[g]);
+      r.live[g] = w[p[g][k]] + w[p[g][k + 1]] + alphaTilde > 0.0 ? 1.0f : 0.0f;
     }
   }
   // A held particle or a dead link is masked, not branched on.
-  for (std::size_t half = 0; half < halves; ++half) solveStiffLanes(rows, n, alphaTilde, half);
+  solveStiffLanes(rows, n, load(alpha));
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
     for (std::size_t g = 0; g < G; ++g) {
-      if (r.moves[g] != 0.0) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
-      if (j > 0 && rows[j - 1].live[g] != 0.0) {
-        if (lambda[g]) lambda[g][j - 1] += r.yl[g] * stiffness;
-        tensionSum[g][j - 1] += r.yl[g] * stiffness;
+      if (r.moves[g] != 0.0f) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
+      if (j > 0 && rows[j - 1].live[g] != 0.0f) {
+        const Real multiplier = static_cast<Real>(r.yl[g]) * unitMass[g] * stiffness;
+        if (lambda[g]) lambda[g][j - 1] += multiplier;
+        tensionSum[g][j - 1] += multiplier;
       }
     }
   }

@@ -64,9 +64,10 @@ struct SolverScratch {
   std::vector<Vec3> lineNormal;
   std::vector<Real> lineUpper, lineSolution;
   // ... and of the line solve with geometric stiffness: per particle of four lines solved together,
-  // each quantity for the four lines side by side, so that the solve runs in vector lanes.
+  // each quantity for the four lines side by side, so that the solve runs in vector lanes (single
+  // precision, in units of each line's first particle's mass).
   struct StiffRows {
-    using Lanes = std::array<Real, 4>;
+    using Lanes = std::array<float, 4>;
     Lanes nx, ny, nz;              // direction of the link to the next particle
     Lanes g;                       // its geometric stiffness: G = g (I - n n^T)
     Lanes rhs;                     // its constraint value, C + alpha~ lambda
