@@ -265,6 +265,10 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       changed |= ImGui::Checkbox("lines", &tuned.solver.lines);
       // On a line of its own: the row above is full.
       if (tuned.solver.lines) changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
+      if (tuned.solver.lines && tuned.solver.tethers) {
+        ImGui::SameLine();
+        changed |= ImGui::Checkbox("tethers between steps", &tuned.solver.tethersBetweenSteps);
+      }
     }
     int threads = session.threads();
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

@@ -320,5 +320,22 @@ TEST(SceneReader, GeometricStiffnessIsPartOfTheLineSolve) {
             "solve), got true");
 }
 
+TEST(SceneReader, TethersBetweenStepsNeedLinesAndTethers) {
+  json document = minimal();
+  applyOverride(document, "solver.lines=true");
+  applyOverride(document, "solver.tethers=true");
+  applyOverride(document, "solver.tethersBetweenSteps=true");
+  EXPECT_TRUE(parseScene(document, "s.json").world.solver.tethersBetweenSteps);
+  EXPECT_FALSE(parseScene(minimal(), "s.json").world.solver.tethersBetweenSteps);
+  for (const char* off : {"solver.lines=false", "solver.tethers=false"}) {
+    json without = document;
+    applyOverride(without, off);
+    EXPECT_EQ(errorOf([&] { parseScene(without, "s.json"); }),
+              "s.json: solver.tethersBetweenSteps: expected false unless \"lines\" and \"tethers\" are true (it "
+              "projects the tethers between the line solve's steps), got true")
+        << off;
+  }
+}
+
 }  // namespace
 }  // namespace drape::scene

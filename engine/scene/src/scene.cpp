@@ -204,8 +204,9 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.tethers = solver.boolean("tethers", false);
     world.solver.lines = solver.boolean("lines", false);
     world.solver.geometricStiffness = solver.boolean("geometricStiffness", false);
+    world.solver.tethersBetweenSteps = solver.boolean("tethersBetweenSteps", false);
     if (world.solver.model != Model::position) {
-      for (const char* key : {"xpbd", "tethers", "lines", "geometricStiffness"}) {
+      for (const char* key : {"xpbd", "tethers", "lines", "geometricStiffness", "tethersBetweenSteps"}) {
         if (solver.has(key) && solver.boolean(key, false)) {
           solver.fail(key, "false for the force model (it belongs to the position model)", solver.raw(key));
         }
@@ -214,6 +215,12 @@ Scene parseScene(const json& document, const std::string& source) {
     if (world.solver.geometricStiffness && !world.solver.lines) {
       solver.fail("geometricStiffness", "false unless \"lines\" is true (it is part of the line solve)",
                   solver.raw("geometricStiffness"));
+    }
+    if (world.solver.tethersBetweenSteps && !(world.solver.lines && world.solver.tethers)) {
+      solver.fail("tethersBetweenSteps",
+                  "false unless \"lines\" and \"tethers\" are true (it projects the tethers between the line "
+                  "solve's steps)",
+                  solver.raw("tethersBetweenSteps"));
     }
     solver.finish();
   }
@@ -300,7 +307,8 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
     for (sim::ClothSettings& cloth : changed.world.cloths) {
       for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(model, kind);
     }
-    if (model == Model::force) solver.xpbd = solver.tethers = solver.lines = solver.geometricStiffness = false;
+    if (model == Model::force)
+      solver.xpbd = solver.tethers = solver.lines = solver.geometricStiffness = solver.tethersBetweenSteps = false;
   }
   solver.model = model;
   solver.integrator = integrator;
@@ -315,6 +323,7 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
       solverDocument.erase("tethers");
       solverDocument.erase("lines");
       solverDocument.erase("geometricStiffness");
+      solverDocument.erase("tethersBetweenSteps");
     }
     if (document.contains("cloths") && document["cloths"].is_array()) {
       for (json& cloth : document["cloths"]) {

@@ -20,8 +20,6 @@ namespace drape::sim::lines {
 
 namespace {
 
-constexpr int kNewtonSteps = 2;
-
 std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   while (parent[i] != i) {
     parent[i] = parent[parent[i]];
@@ -461,9 +459,10 @@ void beginSubstep(SolverScratch& scratch) {
   }
 }
 
-void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
-           Workers& workers, Real* looseLambda) {
+void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+          bool full, Workers& workers) {
   ParticleState& s = cloth.state;
+  full = full && geometricStiffness;
   if (geometricStiffness) {
     const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
@@ -472,46 +471,44 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
       lines.tensionSum.resize(lines.rest.size(), 0.0);
     }
   }
-  // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
-  // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
-  // it does not (docs/performance.md). With geometric stiffness the first step is the full Newton
-  // step (which keeps kinks from growing) and the second the tridiagonal one (which only refines the
-  // lengths): taking both full costs 1.7 times as much on hang2 for no stiffer a cloth.
-  for (int step = 0; step < kNewtonSteps; ++step) {
-    for (SolverScratch::LineFamily& lines : scratch.lines) {
-      if (lines.start.size() < 2) continue;
-      const std::size_t count = lines.start.size() - 1;
-      // Shared out only where each thread gets a few thousand links: below that, waking a helper
-      // costs more than it saves.
-      const std::size_t perLine = std::max<std::size_t>(lines.particle.size() / count, 1);
-      workers.run(
-          count,
-          [&](std::size_t first, std::size_t last, int thread) {
-            const Real alpha = xpbd ? alphaTilde : 0.0;
-            const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
-            inGroups(lines, first, last, xpbd,
-                     [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                        const auto& lambda, const auto& offset, std::size_t n) {
-                       // With geometric stiffness every solve adds its multipliers to the tension sums.
-                       std::array<const Real*, G> tension{};
-                       std::array<Real*, G> tensionSum{};
-                       for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
-                         tension[g] = lines.tension.data() + offset[g];
-                         tensionSum[g] = lines.tensionSum.data() + offset[g];
-                       }
-                       if (geometricStiffness && step == 0) {
-                         solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                            scratch.lineStiff.data() + slice / 4);
-                       } else {
-                         solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
-                                       scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
-                                       scratch.lineSolution.data() + slice);
-                       }
-                     });
-          },
-          std::max<std::size_t>(2048 / perLine, 1));
-    }
+  for (SolverScratch::LineFamily& lines : scratch.lines) {
+    if (lines.start.size() < 2) continue;
+    const std::size_t count = lines.start.size() - 1;
+    // Shared out only where each thread gets a few thousand links: below that, waking a helper
+    // costs more than it saves.
+    const std::size_t perLine = std::max<std::size_t>(lines.particle.size() / count, 1);
+    workers.run(
+        count,
+        [&](std::size_t first, std::size_t last, int thread) {
+          const Real alpha = xpbd ? alphaTilde : 0.0;
+          const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
+          inGroups(lines, first, last, xpbd,
+                   [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
+                                      const auto& lambda, const auto& offset, std::size_t n) {
+                     // With geometric stiffness every solve adds its multipliers to the tension sums.
+                     std::array<const Real*, G> tension{};
+                     std::array<Real*, G> tensionSum{};
+                     for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
+                       tension[g] = lines.tension.data() + offset[g];
+                       tensionSum[g] = lines.tensionSum.data() + offset[g];
+                     }
+                     if (full) {
+                       solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                          scratch.lineStiff.data() + slice / 4);
+                     } else {
+                       solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
+                                     scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
+                                     scratch.lineSolution.data() + slice);
+                     }
+                   });
+        },
+        std::max<std::size_t>(2048 / perLine, 1));
   }
+}
+
+void solveLoose(Cloth& cloth, const SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde,
+                Real* looseLambda) {
+  ParticleState& s = cloth.state;
   const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
   for (const std::uint32_t k : scratch.looseStretch) {
     if (xpbd && looseLambda) {
@@ -520,6 +517,18 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
       position::projectDistance(s.position, s.inverseMass, stretch[k], stiffness);
     }
   }
+}
+
+void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+           Workers& workers, Real* looseLambda) {
+  // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
+  // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
+  // it does not (docs/performance.md). With geometric stiffness the first step is the full Newton
+  // step (which keeps kinks from growing) and the second the tridiagonal one (which only refines the
+  // lengths): taking both full costs 1.7 times as much on hang2 for no stiffer a cloth.
+  step(cloth, scratch, stiffness, xpbd, alphaTilde, geometricStiffness, true, workers);
+  step(cloth, scratch, stiffness, xpbd, alphaTilde, geometricStiffness, false, workers);
+  solveLoose(cloth, scratch, stiffness, xpbd, alphaTilde, looseLambda);
 }
 
 }  // namespace drape::sim::lines

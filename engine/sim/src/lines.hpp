@@ -21,15 +21,23 @@ namespace drape::sim::lines {
 // would give a particle three links in the family or close a loop; then it is loose.
 void build(const Cloth& cloth, SolverScratch& scratch, int threads);
 
-// One sweep over every line of both families, then the loose stretch constraints one by one.
-// `stiffness` scales each correction (position model); with `xpbd`, alphaTilde = compliance / h^2
-// enters the system and scratch lambdas accumulate.
-// The lines of a family are independent: they are shared among the workers.
-// The loose stretch constraints are projected one by one, with XPBD into `looseLambda` (indexed
-// like the cloth's stretch constraints).
-// With `geometricStiffness` each line's solve is a full Newton step, the links' geometric
-// stiffness from the tension they carried over the last substep (scratch.lines[f].tension) included;
-// each solve adds its multipliers to tensionSum.
+// One Newton step of every line's projection from where its particles are now: the rows, then the
+// columns. `stiffness` scales each correction (position model); with `xpbd`, alphaTilde =
+// compliance / h^2 enters the system and the lines' lambdas accumulate. With `geometricStiffness`
+// the step adds its multipliers to tensionSum, and with `full` too it is the full Newton step, the
+// links' geometric stiffness from the tension they carried over the last substep
+// (scratch.lines[f].tension) included; else the tridiagonal (Gauss-Newton) one. The lines of a
+// family are independent: they are shared among the workers.
+void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+          bool full, Workers& workers);
+
+// The loose stretch constraints, projected one by one, with XPBD into `looseLambda` (indexed like
+// the cloth's stretch constraints).
+void solveLoose(Cloth& cloth, const SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde,
+                Real* looseLambda);
+
+// A sweep's stretch solve: two Newton steps over every line of both families (the first full with
+// `geometricStiffness`, the second tridiagonal), then the loose stretch constraints.
 void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
            Workers& workers, Real* looseLambda);
 

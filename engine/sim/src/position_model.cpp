@@ -227,21 +227,34 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
 
 // The fast sweep (solver.lines): tethers first, then bend and shear in batches shared among the
 // workers, then the stretch constraints a line at a time, last, so that a sweep ends with what
-// matters most to the eye, the cloth's length.
+// matters most to the eye, the cloth's length. With solver.tethersBetweenSteps the tethers are
+// projected again between the lines' two Newton steps.
 void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, Workers& workers) {
   ParticleState& s = cloth.state;
-  if (!scratch.tethers.empty()) {
+  const auto tethers = [&] {
+    if (scratch.tethers.empty()) return;
     workers.run(scratch.tethers.size(),
                 [&](std::size_t begin, std::size_t end, int) { projectTethers(s, scratch.tethers, begin, end); });
-  }
+  };
+  tethers();
   for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
     const std::size_t kindIndex = static_cast<std::size_t>(kind);
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
     const Real alphaTilde = material.compliance / (h * h);
     if (kind == ConstraintKind::stretch) {
-      lines::solve(cloth, scratch, solver.xpbd ? 1.0 : material.stiffness, solver.xpbd, alphaTilde,
-                   solver.geometricStiffness, workers, scratch.lambda[kindIndex].data());
+      const Real stiffness = solver.xpbd ? 1.0 : material.stiffness;
+      Real* looseLambda = scratch.lambda[kindIndex].data();
+      if (solver.tethersBetweenSteps) {
+        const bool gs = solver.geometricStiffness;
+        lines::step(cloth, scratch, stiffness, solver.xpbd, alphaTilde, gs, true, workers);
+        tethers();
+        lines::step(cloth, scratch, stiffness, solver.xpbd, alphaTilde, gs, true, workers);
+        lines::solveLoose(cloth, scratch, stiffness, solver.xpbd, alphaTilde, looseLambda);
+      } else {
+        lines::solve(cloth, scratch, stiffness, solver.xpbd, alphaTilde, solver.geometricStiffness, workers,
+                     looseLambda);
+      }
       continue;
     }
     const DistanceConstraint* constraints = cloth.rest.of(kind).data();

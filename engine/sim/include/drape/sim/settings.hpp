@@ -58,6 +58,11 @@ struct SolverSettings {
   // stepped explicitly, and grow unless the substep is shorter than a wave takes to cross a link;
   // with it the substeps a stiff cloth needs no longer grow with its resolution.
   bool geometricStiffness = false;
+  // Position model, with lines and tethers: the tethers are projected again between the line
+  // solve's two Newton steps, and with geometric stiffness both steps are full. A tether's pull and
+  // the lines' lengths then settle together within a sweep instead of across substeps: a fine
+  // stiff cloth hanging from pins needs half the substeps, each about a fifth dearer.
+  bool tethersBetweenSteps = false;
 };
 
 // The air around the cloth, moving uniformly at `velocity`.
