@@ -17,16 +17,19 @@ using namespace drape;
 
 constexpr int kFrames = 120;
 
-// Substeps that keep hang2 within 5 % strain at every frame (drape-cli bench finds them; see
-// docs/performance.md).
-int substepsFor(int n) { return n <= 128 ? 2 : 4; }
+// The cheapest sweep that keeps hang2 within 5 % strain at every frame (drape-cli bench finds it;
+// see docs/performance.md): substeps, and the tethers between the line steps or not.
+bench::Hang2Solver solverFor(int n) {
+  bench::Hang2Solver solver;
+  solver.substeps = n <= 64 ? 1 : 2;
+  solver.tethersBetweenSteps = n != 128;
+  return solver;
+}
 
 void Hang2(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
-  bench::Hang2Solver solver;
-  solver.substeps = substepsFor(n);
-  const sim::WorldSettings settings = bench::hang2(n, solver);
+  const sim::WorldSettings settings = bench::hang2(n, solverFor(n));
   double strain = 0.0;
   for (auto _ : state) {
     state.PauseTiming();

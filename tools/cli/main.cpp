@@ -131,8 +131,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100));
   benchCommand
       ->add_option("--substeps", benchArguments.substeps,
-                   "Substeps of Drape's hang2 solver (default: the fewest that keep strain within 5 % at every frame)")
+                   "Substeps of Drape's hang2 solver (default: the cheapest sweep that keeps strain within 5 % at "
+                   "every frame)")
       ->check(CLI::Range(1, 1000));
+  benchCommand
+      ->add_flag("--tethers-between-steps", benchArguments.tethersBetweenSteps,
+                 "With --substeps: project the tethers again between the line solve's steps (tethersBetweenSteps)")
+      ->needs("--substeps");
   benchCommand->add_flag("--quick", benchArguments.quick,
                          "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps (each unless given)");
   addReportOptions(benchCommand, benchArguments.outDir, benchArguments.report, benchArguments.quiet);

@@ -11,6 +11,7 @@ sim::WorldSettings hang2(int n, const Hang2Solver& solver) {
   world.solver.lines = solver.lines;
   world.solver.tethers = solver.tethers;
   world.solver.geometricStiffness = solver.geometricStiffness;
+  world.solver.tethersBetweenSteps = solver.tethersBetweenSteps;
   world.gravity = {0.0, -9.81, 0.0};
   sim::ClothSettings cloth;
   cloth.lattice = {n, n, 1.0, 1.0, sim::Vec3{0.0, 1.5, 0.0}, sim::LatticePlane::xz};

@@ -9,13 +9,15 @@ namespace drape::bench {
 
 // How Drape solves it (the configuration the benchmark reports): tethers to the two pins, each
 // row and column of stretch constraints solved at once with the links' geometric stiffness,
-// `substeps` substeps of one sweep each.
+// `substeps` substeps of one sweep each; with tethersBetweenSteps the tethers are projected again
+// between the line solve's two Newton steps.
 struct Hang2Solver {
   int substeps = 2;
   int iterations = 1;
   bool lines = true;
   bool tethers = true;
   bool geometricStiffness = true;
+  bool tethersBetweenSteps = false;
 };
 
 sim::WorldSettings hang2(int n, const Hang2Solver& solver = {});
