@@ -265,9 +265,9 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       changed |= ImGui::Checkbox("lines", &tuned.solver.lines);
       // On a line of its own: the row above is full.
       if (tuned.solver.lines) changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
+      // Each on a line of its own: two do not fit side by side.
       if (tuned.solver.lines && tuned.solver.tethers) {
-        ImGui::SameLine();
-        changed |= ImGui::Checkbox("tethers between steps", &tuned.solver.tethersBetweenSteps);
+        changed |= ImGui::Checkbox("tethers between line steps", &tuned.solver.tethersBetweenSteps);
       }
     }
     int threads = session.threads();
