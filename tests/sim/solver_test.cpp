@@ -95,6 +95,7 @@ TEST(Lines, WithoutTensionTheStiffSolveIsTheTridiagonalOne) {
   SolverScratch plain, withStiffness;
   lines::build(bent, plain, 1);
   lines::build(stiff, withStiffness, 1);
+  withStiffness.fullStepRatio = 0.0;  // the full step even with no tension
   Workers workers(1);
   lines::solve(bent, plain, 1.0, false, 0.0, false, workers, nullptr);
   lines::solve(stiff, withStiffness, 1.0, false, 0.0, true, workers, nullptr);
@@ -102,6 +103,31 @@ TEST(Lines, WithoutTensionTheStiffSolveIsTheTridiagonalOne) {
     EXPECT_LT(glm::length(stiff.state.position[i] - bent.state.position[i]), 1e-8) << "particle " << i;
   }
   EXPECT_EQ(stiff.state.position[0], Vec3(0.0));  // pinned: exactly where it was
+}
+
+TEST(Lines, OnlyATautLineTakesTheFullNewtonStep) {
+  // A line whose geometric stiffness stays below a tenth of its particles' mass takes the
+  // tridiagonal step, bit for bit as without geometric stiffness; above it, the full step, which
+  // moves it otherwise.
+  const auto solved = [](bool geometricStiffness, Real ratio) {
+    Cloth cloth = bentChain();
+    SolverScratch scratch;
+    lines::build(cloth, scratch, 1);
+    SolverScratch::LineFamily& line = scratch.lines[0];
+    line.tension.resize(line.rest.size());
+    for (std::size_t k = 0; k + 1 < line.rest.size(); ++k) {
+      line.tension[k] = -ratio * scratch.fullStepRatio * line.rest[k] * cloth.state.mass[line.particle[k]];
+    }
+    Workers workers(1);
+    lines::solve(cloth, scratch, 1.0, false, 0.0, geometricStiffness, workers, nullptr);
+    return cloth.state.position;
+  };
+  const std::vector<Vec3> plain = solved(false, 0.0);
+  EXPECT_EQ(solved(true, 0.5), plain);
+  const std::vector<Vec3> taut = solved(true, 2.0);
+  Real largest = 0.0;
+  for (std::size_t i = 0; i < plain.size(); ++i) largest = std::max(largest, glm::length(taut[i] - plain[i]));
+  EXPECT_GT(largest, 1e-6);
 }
 
 TEST(Lines, TheStiffSolveDoesNotDependOnHowMuchTheClothWeighs) {

@@ -352,39 +352,53 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   }
 }
 
-// Lines [first, last) of a family, four at a time where four in a row are equally long (G = 4),
-// else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests, lambdas,
-// offsets, n), each array holding G lines' pointers (lambdas null without XPBD) and offsets their
-// starts.
+// The lines line[0, count) of a family, four at a time where four in a row are equally long
+// (G = 4), else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests,
+// lambdas, offsets, n), each array holding G lines' pointers (lambdas null without XPBD) and
+// offsets their starts. A line's arithmetic does not depend on which lines it is solved beside.
 template <class Solve>
-void inGroups(SolverScratch::LineFamily& lines, std::size_t first, std::size_t last, bool xpbd, Solve&& solve) {
+void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t count, bool xpbd,
+              Solve&& solve) {
   constexpr std::size_t G = 4;
-  const auto length = [&](std::size_t l) { return lines.start[l + 1] - lines.start[l]; };
-  const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t l, std::size_t n) {
+  const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
+  const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t i, std::size_t n) {
     std::array<const ParticleIndex*, N> p{};
     std::array<const Real*, N> rest{};
     std::array<Real*, N> lambda{};
     std::array<std::size_t, N> offset{};
     for (std::size_t g = 0; g < N; ++g) {
-      offset[g] = lines.start[l + g];
+      offset[g] = lines.start[line[i + g]];
       p[g] = lines.particle.data() + offset[g];
       rest[g] = lines.rest.data() + offset[g];
       lambda[g] = xpbd ? lines.lambda.data() + offset[g] : nullptr;
     }
     solve(size, p, rest, lambda, offset, n);
   };
-  for (std::size_t l = first; l < last;) {
-    const std::size_t n = length(l);
-    bool group = l + G <= last && n >= 2;
-    for (std::size_t g = 1; group && g < G; ++g) group = length(l + g) == n;
+  for (std::size_t i = 0; i < count;) {
+    const std::size_t n = length(i);
+    bool group = i + G <= count && n >= 2;
+    for (std::size_t g = 1; group && g < G; ++g) group = length(i + g) == n;
     if (group) {
-      gather(std::integral_constant<std::size_t, G>{}, l, n);
-      l += G;
+      gather(std::integral_constant<std::size_t, G>{}, i, n);
+      i += G;
       continue;
     }
-    if (n >= 2) gather(std::integral_constant<std::size_t, 1>{}, l, n);
-    ++l;
+    if (n >= 2) gather(std::integral_constant<std::size_t, 1>{}, i, n);
+    ++i;
   }
+}
+
+// Whether line l needs the full Newton step: whether, at any of its links, the geometric stiffness
+// g = tension / length reaches `ratio` (a tenth) of the particle's mass m. g / m is (c h / r)^2, the square
+// of how many links a sideways wave (speed c = sqrt(T / mu)) crosses in a substep: below a third
+// of a link the tridiagonal step keeps a kink from growing, and g changes the step by a tenth at
+// most. (hang2 256: most rows are below it, every column above; the strains it reaches do not
+// change. Rest lengths stand in for lengths.)
+bool needsFullStep(const SolverScratch::LineFamily& lines, std::size_t l, const Real* mass, Real ratio) {
+  for (std::size_t k = lines.start[l]; k + 1 < lines.start[l + 1]; ++k) {
+    if (-lines.tension[k] >= ratio * lines.rest[k] * mass[lines.particle[k]]) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -462,7 +476,7 @@ void beginSubstep(SolverScratch& scratch) {
 void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
           bool full, Workers& workers) {
   ParticleState& s = cloth.state;
-  full = full && geometricStiffness;
+  const bool fullStep = full && geometricStiffness;
   if (geometricStiffness) {
     const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
@@ -477,32 +491,61 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     // Shared out only where each thread gets a few thousand links: below that, waking a helper
     // costs more than it saves.
     const std::size_t perLine = std::max<std::size_t>(lines.particle.size() / count, 1);
-    workers.run(
-        count,
-        [&](std::size_t first, std::size_t last, int thread) {
-          const Real alpha = xpbd ? alphaTilde : 0.0;
-          const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
-          inGroups(lines, first, last, xpbd,
-                   [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                      const auto& lambda, const auto& offset, std::size_t n) {
-                     // With geometric stiffness every solve adds its multipliers to the tension sums.
-                     std::array<const Real*, G> tension{};
-                     std::array<Real*, G> tensionSum{};
-                     for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
-                       tension[g] = lines.tension.data() + offset[g];
-                       tensionSum[g] = lines.tensionSum.data() + offset[g];
-                     }
-                     if (full) {
-                       solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                          scratch.lineStiff.data() + slice / 4);
-                     } else {
-                       solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
-                                     scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
-                                     scratch.lineSolution.data() + slice);
-                     }
-                   });
-        },
-        std::max<std::size_t>(2048 / perLine, 1));
+    const std::size_t grain = std::max<std::size_t>(2048 / perLine, 1);
+    // The lines taut enough to need the full step (needsFullStep) are solved first, then the
+    // others: each share split evenly among the workers, since a full step costs about twice a
+    // tridiagonal one and the taut lines bunch together (near the pins).
+    lines.order.resize(count);
+    std::size_t taut = 0;
+    if (fullStep) {
+      lines.taut.resize(count);
+      workers.run(
+          count,
+          [&](std::size_t first, std::size_t last, int) {
+            for (std::size_t l = first; l < last; ++l) {
+              lines.taut[l] = needsFullStep(lines, l, s.mass.data(), scratch.fullStepRatio) ? 1 : 0;
+            }
+          },
+          grain);
+      for (std::size_t l = 0; l < count; ++l) {
+        if (lines.taut[l]) lines.order[taut++] = static_cast<std::uint32_t>(l);
+      }
+      for (std::size_t l = 0, slack = taut; l < count; ++l) {
+        if (!lines.taut[l]) lines.order[slack++] = static_cast<std::uint32_t>(l);
+      }
+    } else {
+      std::iota(lines.order.begin(), lines.order.end(), 0u);
+    }
+    for (const bool stiff : {true, false}) {
+      const std::size_t from = stiff ? 0 : taut, to = stiff ? taut : count;
+      if (from == to) continue;
+      workers.run(
+          to - from,
+          [&](std::size_t first, std::size_t last, int thread) {
+            const Real alpha = xpbd ? alphaTilde : 0.0;
+            const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
+            inGroups(lines, lines.order.data() + from + first, last - first, xpbd,
+                     [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
+                                        const auto& lambda, const auto& offset, std::size_t n) {
+                       // With geometric stiffness every solve adds its multipliers to the tension sums.
+                       std::array<const Real*, G> tension{};
+                       std::array<Real*, G> tensionSum{};
+                       for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
+                         tension[g] = lines.tension.data() + offset[g];
+                         tensionSum[g] = lines.tensionSum.data() + offset[g];
+                       }
+                       if (stiff) {
+                         solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                            scratch.lineStiff.data() + slice / 4);
+                       } else {
+                         solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
+                                       scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
+                                       scratch.lineSolution.data() + slice);
+                       }
+                     });
+          },
+          grain);
+    }
   }
 }
 

@@ -345,8 +345,8 @@ MemoryUse World::memoryUse() const {
                 bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart);
     m.tethers += bytes(s.tethers);
     for (const SolverScratch::LineFamily& f : s.lines) {
-      m.lines +=
-          bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda) + bytes(f.tension) + bytes(f.tensionSum);
+      m.lines += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda) + bytes(f.tension) +
+                 bytes(f.tensionSum) + bytes(f.taut) + bytes(f.order);
     }
   }
   for (const Snapshot& snapshot : lastGood_) {

@@ -56,7 +56,15 @@ struct SolverScratch {
     // solver.geometricStiffness: the sum of link k's multipliers over the last substep (its
     // tension times h^2, negative when pulled), and over this one so far.
     std::vector<Real> tension, tensionSum;
+    // Per line: 1 if it takes the full Newton step this step; the lines in the order they are
+    // solved (the taut ones first).
+    std::vector<std::uint8_t> taut;
+    std::vector<std::uint32_t> order;
   };
+  // solver.geometricStiffness: a line takes the full Newton step where its geometric stiffness
+  // reaches this fraction of its particles' mass somewhere, else the tridiagonal one (lines.cpp,
+  // needsFullStep). 0: every line the full step.
+  Real fullStepRatio = 0.1;
   std::array<LineFamily, 2> lines;          // along x, and across
   std::vector<std::uint32_t> looseStretch;  // stretch constraints in no line: solved one by one
   // Working arrays of the line solves, as long as the longest line, one slice per thread.
