@@ -1,5 +1,6 @@
 #include "drape/sim/world.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -457,14 +458,29 @@ void World::moveColliders() {
 std::optional<Divergence> World::findBadParticle() const {
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     const ParticleState& s = cloths_[c].state;
-    for (std::size_t i = 0; i < s.position.size(); ++i) {
+    const auto bad = [&](std::size_t i) {
       const Vec3 x = s.position[i];
-      const bool bad = !finite(x) ||
-                       !(glm::abs(x.x) <= kRunawayDistance && glm::abs(x.y) <= kRunawayDistance &&
-                         glm::abs(x.z) <= kRunawayDistance) ||
-                       (!s.velocity.empty() && !(glm::length(s.velocity[i]) <= kRunawaySpeed)) ||
-                       !finite(s.previousPosition[i]);
-      if (bad) return Divergence{stepCount_ + 1, static_cast<int>(c), static_cast<ParticleIndex>(i)};
+      return !finite(x) ||
+             !(glm::abs(x.x) <= kRunawayDistance && glm::abs(x.y) <= kRunawayDistance &&
+               glm::abs(x.z) <= kRunawayDistance) ||
+             (!s.velocity.empty() && !(glm::length(s.velocity[i]) <= kRunawaySpeed)) || !finite(s.previousPosition[i]);
+    };
+    // The first bad particle, whichever part of the cloth each worker looked at.
+    std::atomic<std::size_t> first{s.position.size()};
+    workers_->run(
+        s.position.size(),
+        [&](std::size_t begin, std::size_t end, int) {
+          for (std::size_t i = begin; i < end; ++i) {
+            if (!bad(i)) continue;
+            std::size_t seen = first.load();
+            while (i < seen && !first.compare_exchange_weak(seen, i)) {
+            }
+            return;
+          }
+        },
+        4096);
+    if (first.load() < s.position.size()) {
+      return Divergence{stepCount_ + 1, static_cast<int>(c), static_cast<ParticleIndex>(first.load())};
     }
   }
   return std::nullopt;
@@ -478,9 +494,21 @@ StepStatus World::step() {
   lastGood_.resize(cloths_.size());
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     const ParticleState& s = cloths_[c].state;
-    lastGood_[c].position = s.position;
-    lastGood_[c].previousPosition = s.previousPosition;
-    lastGood_[c].velocity = s.velocity;
+    Snapshot& good = lastGood_[c];
+    good.position.resize(s.position.size());
+    good.previousPosition.resize(s.previousPosition.size());
+    good.velocity.resize(s.velocity.size());
+    workers_->run(
+        s.position.size(),
+        [&](std::size_t begin, std::size_t end, int) {
+          std::copy(s.position.begin() + begin, s.position.begin() + end, good.position.begin() + begin);
+          std::copy(s.previousPosition.begin() + begin, s.previousPosition.begin() + end,
+                    good.previousPosition.begin() + begin);
+          if (!s.velocity.empty()) {
+            std::copy(s.velocity.begin() + begin, s.velocity.begin() + end, good.velocity.begin() + begin);
+          }
+        },
+        4096);
   }
 
   for (StageTiming& timing : profile_) timing.lastSeconds = 0.0;
