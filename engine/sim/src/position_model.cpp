@@ -119,21 +119,13 @@ Vec3 intoBall(Vec3 x, Vec3 c, Real r) {
   return c + d * (r / std::sqrt(length2));
 }
 
-bool inBall(Vec3 x, Vec3 c, Real r) {
-  const Vec3 d = x - c;
-  return glm::dot(d, d) <= r * r * (1.0 + 1e-12);
-}
-
-// The nearest point to x within both balls (Euclidean projection onto their intersection, which
-// is never empty for tethers: the rest shape lies in it). Projecting onto one ball and then the
-// other instead converges slowly where the balls barely overlap, as they do along an edge between
-// two pins (the radii add up to the pins' distance): that edge then sags.
 // The line through two pins: consecutive particles mostly share their pins, so it is worked out
 // once per pair met.
 struct PinAxis {
   ParticleIndex a = ~ParticleIndex{0}, b = ~ParticleIndex{0};
   Vec3 n{0.0};  // unit, from a to b
   Real distance = 0.0;
+  Real halfInverse = 0.0;  // 1 / (2 distance); 0 where the pins coincide
   void update(ParticleIndex pinA, ParticleIndex pinB, Vec3 xa, Vec3 xb) {
     if (pinA == a && pinB == b) return;
     a = pinA;
@@ -141,23 +133,47 @@ struct PinAxis {
     const Vec3 axis = xb - xa;
     distance = glm::length(axis);
     n = distance > 0.0 ? axis / distance : Vec3{0.0};
+    halfInverse = distance > 0.0 ? 0.5 / distance : 0.0;
   }
 };
 
+// Whether along / sqrt(length2) >= t / r (a direction within the cone around the axis whose cosine
+// is t / r), without the square root.
+bool withinCone(Real along, Real length2, Real t, Real r) {
+  const Real lhs = along * along * r * r, rhs = t * t * length2;
+  return t >= 0.0 ? along >= 0.0 && lhs >= rhs : along >= 0.0 || lhs <= rhs;
+}
+
+// The nearest point to x within both balls (Euclidean projection onto their intersection, which
+// is never empty for tethers: the rest shape lies in it). Projecting onto one ball and then the
+// other instead converges slowly where the balls barely overlap, as they do along an edge between
+// two pins (the radii add up to the pins' distance): that edge then sags. Most particles of a
+// hanging sheet are inside both balls or on the circle where the spheres meet: both cost no more
+// than two square roots.
 Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
-  const Vec3 toA = intoBall(x, a, ra);
-  if (inBall(toA, b, rb)) return toA;
-  const Vec3 toB = intoBall(x, b, rb);
-  if (inBall(toB, a, ra)) return toB;
-  // On both spheres: the circle where they meet, centre a + n t, radius rho, in the plane normal to n.
+  const Vec3 fromA = x - a, fromB = x - b;
+  const Real la2 = glm::dot(fromA, fromA), lb2 = glm::dot(fromB, fromB);
+  const bool inA = la2 <= ra * ra, inB = lb2 <= rb * rb;
+  if (inA && inB) return x;
   const Real distance = axis.distance;
-  if (!(distance > 0.0)) return toA;
+  if (!(distance > 0.0)) {  // the pins coincide: the smaller ball
+    return ra <= rb ? intoBall(x, a, ra) : intoBall(x, b, rb);
+  }
   const Vec3 n = axis.n;
-  // Signed: negative where the particle rests beyond pin a.
-  const Real t = std::clamp((distance * distance + ra * ra - rb * rb) / (2.0 * distance), -ra, ra);
-  const Real rho = std::sqrt(std::max(ra * ra - t * t, 0.0));
-  const Vec3 centre = a + n * t;
-  const Vec3 off = (x - centre) - n * glm::dot(x - centre, n);
+  // The spheres meet in the plane at tA from a along n (at tB from b back along it); clamped, a ball
+  // inside the other gives its whole sphere. The part of sphere A inside ball B is the cone of
+  // directions from a whose cosine with n is at least tA / ra; x projects onto it, radially, when
+  // its own direction from a is in that cone. Likewise for B, along -n. Otherwise the nearest
+  // point is on the circle where the spheres meet. (Where one projection lands inside the other
+  // ball it is the nearest point of the lens, as for any intersection of convex sets.)
+  const Real along = glm::dot(fromA, n);  // signed: negative where the particle is beyond pin a
+  const Real tA = std::clamp((distance * distance + ra * ra - rb * rb) * axis.halfInverse, -ra, ra);
+  const Real tB = std::clamp((distance * distance + rb * rb - ra * ra) * axis.halfInverse, -rb, rb);
+  if (!inA && withinCone(along, la2, tA, ra)) return a + fromA * (ra / std::sqrt(la2));
+  if (!inB && withinCone(distance - along, lb2, tB, rb)) return b + fromB * (rb / std::sqrt(lb2));
+  const Real rho = std::sqrt(std::max(ra * ra - tA * tA, 0.0));
+  const Vec3 centre = a + n * tA;
+  const Vec3 off = fromA - n * along;
   const Real offLength = glm::length(off);
   // On the axis every point of the circle is as near; any is as good as another.
   if (!(offLength > 1e-15 * (rho + distance))) return centre;
