@@ -309,10 +309,11 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   // Gathered first: each link's direction, value and geometric stiffness, each particle's mass.
   // Each line's system is solved in units of its first particle's mass (K / s, alpha~ s, l / s,
   // s = that mass), so that single precision holds whatever the cloth weighs.
-  std::array<Real, 4> unitMass{1.0, 1.0, 1.0, 1.0};
+  std::array<Real, 4> unitMass{1.0, 1.0, 1.0, 1.0}, perUnitMass{1.0, 1.0, 1.0, 1.0};
   Lanes alpha{};
   for (std::size_t g = 0; g < G; ++g) {
     unitMass[g] = mass[p[g][0]] > 0.0 ? mass[p[g][0]] : 1.0;
+    perUnitMass[g] = 1.0 / unitMass[g];
     alpha[g] = static_cast<float>(alphaTilde * unitMass[g]);
   }
   for (std::size_t k = 0; k < n; ++k) {
@@ -322,7 +323,7 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
     // the link's direction, value and geometric stiffness (normalise). Lanes no line fills hold a
     // free particle and no link.
     for (std::size_t g = 0; g < 4; ++g) {
-      r.mass[g] = g < G ? static_cast<float>(mass[p[g][k]] / unitMass[g]) : 1.0f;
+      r.mass[g] = g < G ? static_cast<float>(mass[p[g][k]] * perUnitMass[g]) : 1.0f;
       r.moves[g] = g < G && w[p[g][k]] > 0.0 ? 1.0f : 0.0f;
       r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
       if (g >= G || k == links) continue;
@@ -333,21 +334,23 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
       // C + alpha~ lambda = length - (rest - alpha~ lambda)
       r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
       // Pulled links only: a pushed one would make K indefinite.
-      r.g[g] = static_cast<float>(std::max(-tension[g][k], 0.0) / unitMass[g]);
+      r.g[g] = static_cast<float>(std::max(-tension[g][k], 0.0) * perUnitMass[g]);
       r.live[g] = w[p[g][k]] + w[p[g][k + 1]] + alphaTilde > 0.0 ? 1.0f : 0.0f;
     }
   }
   // A held particle or a dead link is masked, not branched on.
   solveStiffLanes(rows, n, load(alpha));
+  // A held particle's move and a dead link's multiplier come out 0: added all the same.
+  std::array<Real, 4> multiplierScale{};
+  for (std::size_t g = 0; g < G; ++g) multiplierScale[g] = unitMass[g] * stiffness;
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
     for (std::size_t g = 0; g < G; ++g) {
-      if (r.moves[g] != 0.0f) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
-      if (j > 0 && rows[j - 1].live[g] != 0.0f) {
-        const Real multiplier = static_cast<Real>(r.yl[g]) * unitMass[g] * stiffness;
-        if (lambda[g]) lambda[g][j - 1] += multiplier;
-        tensionSum[g][j - 1] += multiplier;
-      }
+      x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
+      if (j == 0) continue;
+      const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
+      if (lambda[g]) lambda[g][j - 1] += multiplier;
+      tensionSum[g][j - 1] += multiplier;
     }
   }
 }
