@@ -142,6 +142,10 @@ Lane ones(Mask holds) {
   const Lane one = Lane{} + 1.0f;
   return std::bit_cast<Lane>(holds & std::bit_cast<Mask>(one));
 }
+// a where the comparison holds, else b.
+Lane select(Mask holds, Lane a, Lane b) {
+  return std::bit_cast<Lane>((holds & std::bit_cast<Mask>(a)) | (~holds & std::bit_cast<Mask>(b)));
+}
 Lane squareRoot(Lane a) {
 #if defined(__SSE__)
   return _mm_sqrt_ps(a);
@@ -214,11 +218,11 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTi
   LaneSym3 P;
   Lane3 zx{zero, zero, zero};
   Link next = normalise(rows[0]);
+  LaneSym3 nextAcross = across(next.unit, next.pull);  // G of the link after the node
   {
     Row& r = rows[0];
     const Lane m = load(r.mass);
-    const LaneSym3 inverseA =
-        inverse(LaneSym3{m, m, m, zero, zero, zero} + across(next.unit, next.pull)) * load(r.moves);
+    const LaneSym3 inverseA = inverse(LaneSym3{m, m, m, zero, zero, zero} + nextAcross) * load(r.moves);
     keep(r.inverse, inverseA);
     P = inverseA;
     keep(r.v, zx);
@@ -229,8 +233,10 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTi
   }
   for (std::size_t j = 1; j < n; ++j) {
     const Link link = next;  // joins particle j - 1 to j
+    const LaneSym3 linkAcross = nextAcross;
     Row& r = rows[j];
     next = normalise(r);
+    nextAcross = across(next.unit, next.pull);
     const Lane3 unit = link.unit;
     const Lane pull = link.pull, live = link.live;
     const Lane3 Pn = P * unit;
@@ -242,17 +248,15 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTi
     Lane yl = live * (link.rhs - nz);
     // A = m I + G_{j-1} + G_j - G_{j-1} P G_{j-1}
     const Lane m = load(r.mass);
-    const LaneSym3 A = LaneSym3{m, m, m, zero, zero, zero} + across(unit, pull) + across(next.unit, next.pull) +
+    const LaneSym3 A = LaneSym3{m, m, m, zero, zero, zero} + linkAcross + nextAcross +
                        (P + outer(unit, Pn) * -one + outer(unit) * nPn) * (-pull * pull);
     const LaneSym3 inverseA = inverse(A) * load(r.moves);
     const Lane3 v = inverseA * b;
     Lane schur = c - dot(b, v);
-    for (int lane = 0; lane < 4; ++lane) {
-      if (!(std::abs(schur[lane]) > 0.0f)) {  // both particles held: the link cannot be corrected
-        schur[lane] = 1.0f;
-        yl[lane] = 0.0f;
-      }
-    }
+    // Both particles held (or a zero pivot): the link cannot be corrected.
+    const Mask correctable = (schur > 0.0f) | (schur < 0.0f);
+    schur = select(correctable, schur, one);
+    yl = select(correctable, yl, zero);
     schur = 1.0f / schur;
     const Lane3 t = inverseA * yx;
     const Lane zl = (yl - dot(b, t)) * schur;
