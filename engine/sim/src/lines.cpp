@@ -8,7 +8,9 @@
 #include <numeric>
 #include <type_traits>
 
-#if defined(__SSE__)
+#if defined(__AVX__)
+#include <immintrin.h>
+#elif defined(__SSE__)
 #include <xmmintrin.h>
 #endif
 
@@ -98,10 +100,12 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
   }
 }
 
-// Four floats side by side: four lines' arithmetic in one instruction (SSE, the portable baseline).
-// The full Newton step runs in single precision: it only has to find the direction the second,
-// double-precision step refines (the links' lengths it leaves are that step's to correct).
-using Lane = float __attribute__((vector_size(16)));
+// Floats side by side, one line's arithmetic in each: four lines in one instruction (SSE, the
+// portable baseline), eight with AVX. The full Newton step runs in single precision: it only has to
+// find the direction the second, double-precision step refines (the links' lengths it leaves are
+// that step's to correct).
+constexpr std::size_t kLanes = SolverScratch::StiffRows::kLanes;
+using Lane = float __attribute__((vector_size(4 * kLanes)));
 using Lanes = SolverScratch::StiffRows::Lanes;
 struct Lane3 {
   Lane x, y, z;
@@ -136,7 +140,7 @@ Lane3 operator+(const Lane3& a, const Lane3& b) { return {a.x + b.x, a.y + b.y, 
 Lane3 operator-(const Lane3& a, const Lane3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 Lane3 operator*(const Lane3& a, Lane s) { return {a.x * s, a.y * s, a.z * s}; }
 Lane dot(const Lane3& a, const Lane3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-using Mask = std::int32_t __attribute__((vector_size(16)));
+using Mask = std::int32_t __attribute__((vector_size(4 * kLanes)));
 // 1 in the lanes a comparison holds in, else 0.
 Lane ones(Mask holds) {
   const Lane one = Lane{} + 1.0f;
@@ -147,10 +151,12 @@ Lane select(Mask holds, Lane a, Lane b) {
   return std::bit_cast<Lane>((holds & std::bit_cast<Mask>(a)) | (~holds & std::bit_cast<Mask>(b)));
 }
 Lane squareRoot(Lane a) {
-#if defined(__SSE__)
+#if defined(__AVX__)
+  return _mm256_sqrt_ps(a);
+#elif defined(__SSE__)
   return _mm_sqrt_ps(a);
 #else
-  for (int lane = 0; lane < 4; ++lane) a[lane] = std::sqrt(a[lane]);
+  for (std::size_t lane = 0; lane < kLanes; ++lane) a[lane] = std::sqrt(a[lane]);
   return a;
 #endif
 }
@@ -298,13 +304,13 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTi
 // eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
 // 3 x 3 inverse and a scalar pivot), so a held particle (whose unknowns drop out) never leaves a
 // link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
-// solved by solveStiffLanes four lines at once, and the moves and multipliers scattered back.
+// solved by solveStiffLanes kLanes lines at once, and the moves and multipliers scattered back.
 template <std::size_t G>
 void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                      const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
                      const std::array<const Real*, G>& tension, const std::array<Real*, G>& tensionSum, std::size_t n,
                      Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows) {
-  static_assert(G <= 4);
+  static_assert(G <= kLanes);
   using Row = SolverScratch::StiffRows;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -313,7 +319,9 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   // Gathered first: each link's direction, value and geometric stiffness, each particle's mass.
   // Each line's system is solved in units of its first particle's mass (K / s, alpha~ s, l / s,
   // s = that mass), so that single precision holds whatever the cloth weighs.
-  std::array<Real, 4> unitMass{1.0, 1.0, 1.0, 1.0}, perUnitMass{1.0, 1.0, 1.0, 1.0};
+  std::array<Real, kLanes> unitMass, perUnitMass;
+  unitMass.fill(1.0);
+  perUnitMass.fill(1.0);
   Lanes alpha{};
   for (std::size_t g = 0; g < G; ++g) {
     unitMass[g] = mass[p[g][0]] > 0.0 ? mass[p[g][0]] : 1.0;
@@ -326,7 +334,7 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
     // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
     // the link's direction, value and geometric stiffness (normalise). Lanes no line fills hold a
     // free particle and no link.
-    for (std::size_t g = 0; g < 4; ++g) {
+    for (std::size_t g = 0; g < kLanes; ++g) {
       r.mass[g] = g < G ? static_cast<float>(mass[p[g][k]] * perUnitMass[g]) : 1.0f;
       r.moves[g] = g < G && w[p[g][k]] > 0.0 ? 1.0f : 0.0f;
       r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
@@ -345,7 +353,7 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   // A held particle or a dead link is masked, not branched on.
   solveStiffLanes(rows, n, load(alpha));
   // A held particle's move and a dead link's multiplier come out 0: added all the same.
-  std::array<Real, 4> multiplierScale{};
+  std::array<Real, kLanes> multiplierScale{};
   for (std::size_t g = 0; g < G; ++g) multiplierScale[g] = unitMass[g] * stiffness;
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
@@ -359,14 +367,14 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   }
 }
 
-// The lines line[0, count) of a family, four at a time where four in a row are equally long
-// (G = 4), else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests,
+// The lines line[0, count) of a family, W at a time where W in a row are equally long (G = W),
+// else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests,
 // lambdas, offsets, n), each array holding G lines' pointers (lambdas null without XPBD) and
 // offsets their starts. A line's arithmetic does not depend on which lines it is solved beside.
-template <class Solve>
+template <std::size_t W, class Solve>
 void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t count, bool xpbd,
               Solve&& solve) {
-  constexpr std::size_t G = 4;
+  constexpr std::size_t G = W;
   const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
   const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t i, std::size_t n) {
     std::array<const ParticleIndex*, N> p{};
@@ -531,25 +539,35 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
           [&](std::size_t first, std::size_t last, int thread) {
             const Real alpha = xpbd ? alphaTilde : 0.0;
             const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
-            inGroups(lines, lines.order.data() + from + first, last - first, xpbd,
-                     [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                        const auto& lambda, const auto& offset, std::size_t n) {
-                       // With geometric stiffness every solve adds its multipliers to the tension sums.
-                       std::array<const Real*, G> tension{};
-                       std::array<Real*, G> tensionSum{};
-                       for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
-                         tension[g] = lines.tension.data() + offset[g];
-                         tensionSum[g] = lines.tensionSum.data() + offset[g];
-                       }
-                       if (stiff) {
-                         solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                            scratch.lineStiff.data() + slice / 4);
-                       } else {
-                         solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
-                                       scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
-                                       scratch.lineSolution.data() + slice);
-                       }
-                     });
+            const std::uint32_t* line = lines.order.data() + from + first;
+            if (stiff) {
+              inGroups<kLanes>(
+                  lines, line, last - first, xpbd,
+                  [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
+                                     const auto& lambda, const auto& offset, std::size_t n) {
+                    std::array<const Real*, G> tension{};
+                    std::array<Real*, G> tensionSum{};
+                    for (std::size_t g = 0; g < G; ++g) {
+                      tension[g] = lines.tension.data() + offset[g];
+                      tensionSum[g] = lines.tensionSum.data() + offset[g];
+                    }
+                    solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                       scratch.lineStiff.data() + slice / 4);
+                  });
+            } else {
+              // With geometric stiffness every solve adds its multipliers to the tension sums.
+              inGroups<4>(lines, line, last - first, xpbd,
+                          [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
+                                             const auto& lambda, const auto& offset, std::size_t n) {
+                            std::array<Real*, G> tensionSum{};
+                            for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
+                              tensionSum[g] = lines.tensionSum.data() + offset[g];
+                            }
+                            solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
+                                          scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
+                                          scratch.lineSolution.data() + slice);
+                          });
+            }
           },
           grain);
     }

@@ -71,11 +71,18 @@ struct SolverScratch {
   std::size_t lineStride = 0;
   std::vector<Vec3> lineNormal;
   std::vector<Real> lineUpper, lineSolution;
-  // ... and of the line solve with geometric stiffness: per particle of four lines solved together,
-  // each quantity for the four lines side by side, so that the solve runs in vector lanes (single
-  // precision, in units of each line's first particle's mass).
+  // ... and of the line solve with geometric stiffness: per particle of kLanes lines solved
+  // together, each quantity for those lines side by side, so that the solve runs in vector lanes
+  // (single precision, in units of each line's first particle's mass).
   struct StiffRows {
-    using Lanes = std::array<float, 4>;
+    // Lines solved side by side: as many floats as a vector register holds (8 with AVX, in a build
+    // for this machine's CPU; else 4, SSE).
+#if defined(__AVX__)
+    static constexpr std::size_t kLanes = 8;
+#else
+    static constexpr std::size_t kLanes = 4;
+#endif
+    using Lanes = std::array<float, kLanes>;
     Lanes nx, ny, nz;              // direction of the link to the next particle
     Lanes g;                       // its geometric stiffness: G = g (I - n n^T)
     Lanes rhs;                     // its constraint value, C + alpha~ lambda
