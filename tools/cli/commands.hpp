@@ -73,7 +73,7 @@ struct BenchArguments {
   std::vector<int> naiveIterations{10, 200};                      // the naive baseline's sweeps per frame
   std::vector<std::string> scenes{"drape-sphere", "hang2-tear"};  // more scenes (Drape's solver only)
   int frames = 120;
-  int repeats = 3;                   // timed runs (median); fewer once a case has taken 20 s
+  int repeats = 5;                   // timed runs (median); fewer once a case has taken 20 s
   int substeps = 0;                  // Drape's hang2 substeps (of one sweep); 0: the cheapest sweep within 5 % strain
   bool tethersBetweenSteps = false;  // with substeps: Drape's sweep projects the tethers between line steps
   bool quick = false;  // a smoke test: small sizes, few frames (main.cpp applies it to the options not given)

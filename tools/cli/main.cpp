@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   benchCommand->add_option("--frames", benchArguments.frames, "Frames per run (default 120)")
       ->check(CLI::Range(1, 100000));
-  benchCommand->add_option("--repeats", benchArguments.repeats, "Timed runs per case (median; default 3)")
+  benchCommand->add_option("--repeats", benchArguments.repeats, "Timed runs per case (median; default 5)")
       ->check(CLI::Range(1, 100));
   benchCommand
       ->add_option("--substeps", benchArguments.substeps,
