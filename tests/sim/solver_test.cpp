@@ -116,7 +116,8 @@ TEST(Lines, OnlyATautLineTakesTheFullNewtonStep) {
     SolverScratch::LineFamily& line = scratch.lines[0];
     line.tension.resize(line.rest.size());
     for (std::size_t k = 0; k + 1 < line.rest.size(); ++k) {
-      line.tension[k] = -ratio * scratch.fullStepRatio * line.rest[k] * cloth.state.mass[line.particle[k]];
+      line.tension[k] =
+          static_cast<float>(-ratio * scratch.fullStepRatio * line.rest[k] * cloth.state.mass[line.particle[k]]);
     }
     Workers workers(1);
     lines::solve(cloth, scratch, 1.0, false, 0.0, geometricStiffness, workers, nullptr);
@@ -139,7 +140,7 @@ TEST(Lines, TheStiffSolveDoesNotDependOnHowMuchTheClothWeighs) {
     for (Real& w : cloth.state.inverseMass) w /= massScale;
     SolverScratch scratch;
     lines::build(cloth, scratch, 1);
-    scratch.lines[0].tension.assign(scratch.lines[0].rest.size(), -1e-3 * massScale);
+    scratch.lines[0].tension.assign(scratch.lines[0].rest.size(), static_cast<float>(-1e-3 * massScale));
     Workers workers(1);
     lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
     return cloth.state.position;
@@ -160,7 +161,7 @@ TEST(Lines, UnderTensionAStraightStretchedChainIsStillExactInOneSolve) {
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) cloth.state.position[i].x *= 1.3;
   SolverScratch scratch;
   lines::build(cloth, scratch, 1);
-  scratch.lines[0].tension.assign(scratch.lines[0].rest.size(), -1e-3);  // pulled hard
+  scratch.lines[0].tension.assign(scratch.lines[0].rest.size(), -1e-3f);  // pulled hard
   Workers workers(1);
   lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
   EXPECT_LT(worstViolation(cloth), 1e-12);

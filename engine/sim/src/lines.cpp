@@ -36,7 +36,7 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
 template <std::size_t G>
 void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, const std::array<const Real*, G>& rest,
-                const std::array<Real*, G>& lambda, const std::array<Real*, G>& tensionSum, std::size_t n,
+                const std::array<Real*, G>& lambda, const std::array<float*, G>& tensionSum, std::size_t n,
                 Real stiffness, Real alphaTilde, Vec3* normal, Real* upper, Real* solution) {
   const std::size_t links = n - 1;
   Vec3* x = s.position.data();
@@ -92,7 +92,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
       const std::size_t at = k * G + g;
       const Real dl = solution[at] * stiffness;
       if (lambda[g]) lambda[g][k] += dl;
-      if (tensionSum[g]) tensionSum[g][k] += dl;
+      if (tensionSum[g]) tensionSum[g][k] = static_cast<float>(tensionSum[g][k] + dl);
       const Vec3 push = normal[at] * dl;
       x[p[g][k]] -= push * w[p[g][k]];
       x[p[g][k + 1]] += push * w[p[g][k + 1]];
@@ -308,7 +308,7 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTi
 template <std::size_t G>
 void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                      const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
-                     const std::array<const Real*, G>& tension, const std::array<Real*, G>& tensionSum, std::size_t n,
+                     const std::array<const float*, G>& tension, const std::array<float*, G>& tensionSum, std::size_t n,
                      Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows) {
   static_assert(G <= kLanes);
   using Row = SolverScratch::StiffRows;
@@ -346,7 +346,7 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
       // C + alpha~ lambda = length - (rest - alpha~ lambda)
       r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
       // Pulled links only: a pushed one would make K indefinite.
-      r.g[g] = static_cast<float>(std::max(-tension[g][k], 0.0) * perUnitMass[g]);
+      r.g[g] = static_cast<float>(std::max(-static_cast<Real>(tension[g][k]), 0.0) * perUnitMass[g]);
       r.live[g] = w[p[g][k]] + w[p[g][k + 1]] + alphaTilde > 0.0 ? 1.0f : 0.0f;
     }
   }
@@ -362,7 +362,7 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;
-      tensionSum[g][j - 1] += multiplier;
+      tensionSum[g][j - 1] = static_cast<float>(tensionSum[g][j - 1] + multiplier);
     }
   }
 }
@@ -484,7 +484,7 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
 void beginSubstep(SolverScratch& scratch) {
   for (SolverScratch::LineFamily& lines : scratch.lines) {
     lines.tension.swap(lines.tensionSum);
-    std::fill(lines.tensionSum.begin(), lines.tensionSum.end(), 0.0);
+    std::fill(lines.tensionSum.begin(), lines.tensionSum.end(), 0.0f);
   }
 }
 
@@ -496,8 +496,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
     for (SolverScratch::LineFamily& lines : scratch.lines) {  // sized here alone (zero: no tension yet)
-      lines.tension.resize(lines.rest.size(), 0.0);
-      lines.tensionSum.resize(lines.rest.size(), 0.0);
+      lines.tension.resize(lines.rest.size(), 0.0f);
+      lines.tensionSum.resize(lines.rest.size(), 0.0f);
     }
   }
   for (SolverScratch::LineFamily& lines : scratch.lines) {
@@ -545,8 +545,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                   lines, line, last - first, xpbd,
                   [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
                                      const auto& lambda, const auto& offset, std::size_t n) {
-                    std::array<const Real*, G> tension{};
-                    std::array<Real*, G> tensionSum{};
+                    std::array<const float*, G> tension{};
+                    std::array<float*, G> tensionSum{};
                     for (std::size_t g = 0; g < G; ++g) {
                       tension[g] = lines.tension.data() + offset[g];
                       tensionSum[g] = lines.tensionSum.data() + offset[g];
@@ -559,7 +559,7 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
               inGroups<4>(lines, line, last - first, xpbd,
                           [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
                                              const auto& lambda, const auto& offset, std::size_t n) {
-                            std::array<Real*, G> tensionSum{};
+                            std::array<float*, G> tensionSum{};
                             for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
                               tensionSum[g] = lines.tensionSum.data() + offset[g];
                             }

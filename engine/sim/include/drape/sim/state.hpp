@@ -54,8 +54,9 @@ struct SolverScratch {
     std::vector<Real> rest;    // m, link k joins particle[k] and particle[k + 1] (unused at a line's end)
     std::vector<Real> lambda;  // XPBD: multiplier of link k, reset each substep
     // solver.geometricStiffness: the sum of link k's multipliers over the last substep (its
-    // tension times h^2, negative when pulled), and over this one so far.
-    std::vector<Real> tension, tensionSum;
+    // tension times h^2, negative when pulled), and over this one so far. Single precision: they
+    // only scale the geometric stiffness, and choose which lines take the full step.
+    std::vector<float> tension, tensionSum;
     // Per line: 1 if it takes the full Newton step this step; the lines in the order they are
     // solved (the taut ones first).
     std::vector<std::uint8_t> taut;
