@@ -617,6 +617,54 @@ TEST(Tethers, TheLensIsRightWhereAParticleRestsBeyondAPin) {
   }
 }
 
+TEST(Tethers, WithAPinCarriedIntoTheOtherBallTheLensIsTheInnerBall) {
+  // Pins at (0, 0, 0) and (1, 0, 0), as above. A finger carries one pin to 0.3 m from the other, so
+  // that one tether ball lies inside the other: the lens is the inner ball, and a particle anywhere,
+  // on the pins' axis too, goes to its nearest point.
+  WorldSettings settings;
+  settings.solver.tethers = true;
+  settings.solver.iterations = 1;
+  settings.gravity = Vec3{0.0};
+  ClothSettings cloth = test::chainCloth(4, 2, 1.5, 0.8, 8.0, Vec3{-0.5, 0.0, 0.0}, LatticePlane::xz, {1e-12, 0.0});
+  cloth.pins = {{1, 0, std::nullopt}, {3, 0, std::nullopt}};
+  settings.cloths.push_back(cloth);
+  struct Case {
+    std::size_t particle, movedPin;
+    Vec3 rest, a, b;  // the particle at rest; the pins once one has moved
+  };
+  // Particle (0, 1): ball A (0.94 m) inside ball B (1.70 m). Particle (3, 1): B (0.8 m) inside A (1.28 m).
+  const Case cases[] = {{4, 3, Vec3{-0.5, 0.0, 0.8}, Vec3{0.0}, Vec3{0.3, 0.0, 0.0}},
+                        {7, 1, Vec3{1.0, 0.0, 0.8}, Vec3{0.7, 0.0, 0.0}, Vec3{1.0, 0.0, 0.0}}};
+  std::mt19937 random(5);
+  std::uniform_real_distribution<Real> coordinate(-3.0, 3.0);
+  for (const Case& c : cases) {
+    const Real ra = glm::length(c.rest - Vec3{0.0}), rb = glm::length(c.rest - Vec3{1.0, 0.0, 0.0});
+    const bool aInner = ra < rb;
+    const Vec3 inner = aInner ? c.a : c.b;
+    const Real innerRadius = aInner ? ra : rb;
+    for (int trial = 0; trial < 40; ++trial) {
+      // The first starts on the axis, beyond either pin and between them.
+      const Real along[] = {-2.5, -1.2, 0.5, 2.1, 3.0};
+      const Vec3 start =
+          trial < 5 ? Vec3{along[trial], 0.0, 0.0} : Vec3{coordinate(random), coordinate(random), coordinate(random)};
+      World world(settings);
+      std::vector<Cloth> cloths = world.cloths();
+      ParticleState& s = cloths[0].state;
+      s.position[c.movedPin] = s.previousPosition[c.movedPin] = c.movedPin == 1 ? c.a : c.b;
+      s.position[c.particle] = s.previousPosition[c.particle] = start;
+      world.restoreCloths(cloths);
+      world.step();
+      const Vec3 x = world.cloths()[0].state.position[c.particle];
+      const Vec3 fromInner = start - inner;
+      const Vec3 expected =
+          glm::length(fromInner) <= innerRadius ? start : inner + fromInner * (innerRadius / glm::length(fromInner));
+      ASSERT_LT(glm::length(x - expected), 1e-9) << "particle " << c.particle << ", trial " << trial;
+      ASSERT_LE(glm::length(x - c.a), ra + 1e-9);
+      ASSERT_LE(glm::length(x - c.b), rb + 1e-9);
+    }
+  }
+}
+
 TEST(FastSweep, ASecondTearOfAChainBreaksTheLinkThatIsPulled) {
   // A chain of 12 particles 10 cm apart between two pins, soft enough to be pulled past the tearing
   // threshold. Particle 3 is pulled aside: a link at it tears. Then particle 8: a link at it must
@@ -665,6 +713,20 @@ TEST(FastSweep, TwoThreadsShareLinesAndParticlesAndStayBitIdentical) {
   const WorldSettings settings = fastSheet(130, 2);
   const std::vector<Vec3> one = test::positionsAfter(settings, 1, 5);
   EXPECT_EQ(test::positionsAfter(settings, 2, 5), one);
+}
+
+TEST(FastSweep, ThreadsSplittingTautAndSlackLinesStayBitIdentical) {
+  // 151 lines a family, cut among 2 and 3 threads into different groups, taut lines (the full step)
+  // and slack ones (the tridiagonal) each: with geometric stiffness, and with the tethers between
+  // the line steps too. Ten frames, long enough for tension to build and the lines to part.
+  for (const bool between : {false, true}) {
+    WorldSettings settings = fastSheet(151, 2);
+    settings.solver.geometricStiffness = true;
+    settings.solver.tethersBetweenSteps = between;
+    const std::vector<Vec3> one = test::positionsAfter(settings, 1, 10);
+    EXPECT_EQ(test::positionsAfter(settings, 2, 10), one) << "tethers between steps " << between;
+    EXPECT_EQ(test::positionsAfter(settings, 3, 10), one) << "tethers between steps " << between;
+  }
 }
 
 TEST(Lines, XpbdLooseLinksKeepTheirCompliance) {

@@ -352,13 +352,14 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   }
   // A held particle or a dead link is masked, not branched on.
   solveStiffLanes(rows, n, load(alpha));
-  // A held particle's move and a dead link's multiplier come out 0: added all the same.
+  // A dead link's multiplier comes out 0 and is added all the same; a held particle is not touched
+  // (its move is 0 too, but it must stay put even if something upstream went non-finite).
   std::array<Real, kLanes> multiplierScale{};
   for (std::size_t g = 0; g < G; ++g) multiplierScale[g] = unitMass[g] * stiffness;
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
     for (std::size_t g = 0; g < G; ++g) {
-      x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
+      if (r.moves[g] != 0.0f) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;

@@ -169,6 +169,12 @@ Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
   const Real along = glm::dot(fromA, n);  // signed: negative where the particle is beyond pin a
   const Real tA = std::clamp((distance * distance + ra * ra - rb * rb) * axis.halfInverse, -ra, ra);
   const Real tB = std::clamp((distance * distance + rb * rb - ra * ra) * axis.halfInverse, -rb, rb);
+  // One ball inside the other (a pin carried towards the other): the lens is the inner ball. A cone
+  // clamped to a single ray would let a particle on the axis through to the outer sphere. (Told from
+  // the radii, not from tA and tB: along an edge between two pins the balls touch from outside,
+  // ra + rb = distance, and both clamp.)
+  if (distance + rb <= ra) return intoBall(x, b, rb);
+  if (distance + ra <= rb) return intoBall(x, a, ra);
   if (!inA && withinCone(along, la2, tA, ra)) return a + fromA * (ra / std::sqrt(la2));
   if (!inB && withinCone(distance - along, lb2, tB, rb)) return b + fromB * (rb / std::sqrt(lb2));
   const Real rho = std::sqrt(std::max(ra * ra - tA * tA, 0.0));
