@@ -77,7 +77,8 @@ struct SolverScratch {
   // (single precision, in units of each line's first particle's mass).
   struct StiffRows {
     // Lines solved side by side: as many floats as a vector register holds (8 with AVX, in a build
-    // for this machine's CPU; else 4, SSE).
+    // for this machine's CPU; else 4, SSE). The layout thus follows the compile flags: everything
+    // that includes this header must be built with the same ones (the project sets them globally).
 #if defined(__AVX__)
     static constexpr std::size_t kLanes = 8;
 #else
