@@ -582,9 +582,9 @@ TEST(FastSweep, ThreadsAreCheckedAndTheStageListStaysBare) {
   EXPECT_EQ(stages, (std::vector<Stage>{Stage::verletIntegrate, Stage::projectConstraints, Stage::guard}));
 }
 
-TEST(Tethers, TheLensIsRightWhereAParticleRestsBeyondAPin) {
-  // Pins at (0, 0, 0) and (1, 0, 0); particle (0, 1) rests at (-0.5, 0, 0.8), beyond the first pin
-  // along their axis: the circle where its two tether spheres meet lies on that side of the pin.
+// A 4 x 2 lattice 1.5 x 0.8 m from x = -0.5, held by tethers alone (its constraints all but off, no
+// gravity), pinned at (1, 0) and (3, 0): at (0, 0, 0) and (1, 0, 0).
+WorldSettings lensLattice() {
   WorldSettings settings;
   settings.solver.tethers = true;
   settings.solver.iterations = 1;
@@ -592,6 +592,13 @@ TEST(Tethers, TheLensIsRightWhereAParticleRestsBeyondAPin) {
   ClothSettings cloth = test::chainCloth(4, 2, 1.5, 0.8, 8.0, Vec3{-0.5, 0.0, 0.0}, LatticePlane::xz, {1e-12, 0.0});
   cloth.pins = {{1, 0, std::nullopt}, {3, 0, std::nullopt}};
   settings.cloths.push_back(cloth);
+  return settings;
+}
+
+TEST(Tethers, TheLensIsRightWhereAParticleRestsBeyondAPin) {
+  // Pins at (0, 0, 0) and (1, 0, 0); particle (0, 1) rests at (-0.5, 0, 0.8), beyond the first pin
+  // along their axis: the circle where its two tether spheres meet lies on that side of the pin.
+  const WorldSettings settings = lensLattice();
   const Vec3 a{0.0}, b{1.0, 0.0, 0.0}, rest{-0.5, 0.0, 0.8};
   const Real ra = glm::length(rest - a), rb = glm::length(rest - b);
   std::mt19937 random(11);
@@ -621,13 +628,7 @@ TEST(Tethers, WithAPinCarriedIntoTheOtherBallTheLensIsTheInnerBall) {
   // Pins at (0, 0, 0) and (1, 0, 0), as above. A finger carries one pin to 0.3 m from the other, so
   // that one tether ball lies inside the other: the lens is the inner ball, and a particle anywhere,
   // on the pins' axis too, goes to its nearest point.
-  WorldSettings settings;
-  settings.solver.tethers = true;
-  settings.solver.iterations = 1;
-  settings.gravity = Vec3{0.0};
-  ClothSettings cloth = test::chainCloth(4, 2, 1.5, 0.8, 8.0, Vec3{-0.5, 0.0, 0.0}, LatticePlane::xz, {1e-12, 0.0});
-  cloth.pins = {{1, 0, std::nullopt}, {3, 0, std::nullopt}};
-  settings.cloths.push_back(cloth);
+  const WorldSettings settings = lensLattice();
   struct Case {
     std::size_t particle, movedPin;
     Vec3 rest, a, b;  // the particle at rest; the pins once one has moved

@@ -186,8 +186,6 @@ LaneSym3 outer(const Lane3& u, const Lane3& v) {
           cxz * inv, (a.xy * a.xz - a.xx * a.yz) * inv};
 }
 
-// The elimination of solveStiffLines for the four lanes of rows[0, n), gathered. On return each
-// row's yx holds its particle's move and yl its link-before's multiplier.
 // A link as the solve uses it: its direction, geometric stiffness g, value C + alpha~ lambda, and 1
 // if the solve corrects it (else 0).
 struct Link {
@@ -198,7 +196,7 @@ struct Link {
 // Link j from what solveStiffLines gathered into row j: the difference of its particles (in nx, ny,
 // nz), its rest length less alpha~ lambda (rhs), its tension over the unit mass (g) and 1 if
 // anything can move it (live). A link with no direction is dead. Keeps in the row what the back
-// substitution and the scatter read again: the direction, g and live.
+// substitution reads again: the direction and g.
 Link normalise(SolverScratch::StiffRows& r) {
   const Lane3 d{load(r.nx), load(r.ny), load(r.nz)};
   const Lane length2 = dot(d, d);
@@ -210,11 +208,10 @@ Link normalise(SolverScratch::StiffRows& r) {
   keep(r.ny, link.unit.y);
   keep(r.nz, link.unit.z);
   keep(r.g, link.pull);
-  keep(r.live, live);
   return link;
 }
 
-// The elimination of solveStiffLines for the four lanes of rows[0, n), gathered. On return each
+// The elimination of solveStiffLines for the kLanes lanes of rows[0, n), gathered. On return each
 // row's yx holds its particle's move and yl its link-before's multiplier.
 void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTilde) {
   using Row = SolverScratch::StiffRows;

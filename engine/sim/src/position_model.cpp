@@ -159,22 +159,22 @@ Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
   if (!(distance > 0.0)) {  // the pins coincide: the smaller ball
     return ra <= rb ? intoBall(x, a, ra) : intoBall(x, b, rb);
   }
+  // One ball inside the other (a pin carried towards the other): the lens is the inner ball. The
+  // cones below would clamp to a single ray and let a particle on the axis through to the outer
+  // sphere. (Told from the radii: along an edge between two pins the balls touch from outside,
+  // ra + rb = distance, and that case belongs to the circle.)
+  if (distance + rb <= ra) return intoBall(x, b, rb);
+  if (distance + ra <= rb) return intoBall(x, a, ra);
   const Vec3 n = axis.n;
-  // The spheres meet in the plane at tA from a along n (at tB from b back along it); clamped, a ball
-  // inside the other gives its whole sphere. The part of sphere A inside ball B is the cone of
-  // directions from a whose cosine with n is at least tA / ra; x projects onto it, radially, when
-  // its own direction from a is in that cone. Likewise for B, along -n. Otherwise the nearest
-  // point is on the circle where the spheres meet. (Where one projection lands inside the other
-  // ball it is the nearest point of the lens, as for any intersection of convex sets.)
+  // The spheres meet in the plane at tA from a along n (at tB from b back along it). The part of
+  // sphere A inside ball B is the cone of directions from a whose cosine with n is at least
+  // tA / ra; x projects onto it, radially, when its own direction from a is in that cone. Likewise
+  // for B, along -n. Otherwise the nearest point is on the circle where the spheres meet. (Where
+  // one projection lands inside the other ball it is the nearest point of the lens, as for any
+  // intersection of convex sets.)
   const Real along = glm::dot(fromA, n);  // signed: negative where the particle is beyond pin a
   const Real tA = std::clamp((distance * distance + ra * ra - rb * rb) * axis.halfInverse, -ra, ra);
   const Real tB = std::clamp((distance * distance + rb * rb - ra * ra) * axis.halfInverse, -rb, rb);
-  // One ball inside the other (a pin carried towards the other): the lens is the inner ball. A cone
-  // clamped to a single ray would let a particle on the axis through to the outer sphere. (Told from
-  // the radii, not from tA and tB: along an edge between two pins the balls touch from outside,
-  // ra + rb = distance, and both clamp.)
-  if (distance + rb <= ra) return intoBall(x, b, rb);
-  if (distance + ra <= rb) return intoBall(x, a, ra);
   if (!inA && withinCone(along, la2, tA, ra)) return a + fromA * (ra / std::sqrt(la2));
   if (!inB && withinCone(distance - along, lb2, tB, rb)) return b + fromB * (rb / std::sqrt(lb2));
   const Real rho = std::sqrt(std::max(ra * ra - tA * tA, 0.0));

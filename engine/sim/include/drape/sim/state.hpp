@@ -64,7 +64,7 @@ struct SolverScratch {
   };
   // solver.geometricStiffness: a line takes the full Newton step where its geometric stiffness
   // reaches this fraction of its particles' mass somewhere, else the tridiagonal one (lines.cpp,
-  // needsFullStep). 0: every line the full step.
+  // needsFullStep). 0: every line with a link that is not pushed.
   Real fullStepRatio = 0.1;
   std::array<LineFamily, 2> lines;          // along x, and across
   std::vector<std::uint32_t> looseStretch;  // stretch constraints in no line: solved one by one
