@@ -666,6 +666,78 @@ TEST(Tethers, WithAPinCarriedIntoTheOtherBallTheLensIsTheInnerBall) {
   }
 }
 
+TEST(Tethers, RunsKeepEveryTetherAndSharePinsOnlyBetweenParticlesThatFollowEachOther) {
+  using Tether = SolverScratch::Tethers::Tether;
+  // Particles 1 and 2 share pins 0 and 5; 3 has pin 0 alone; 4 and 6 have 0 and 5 again, but 3 and
+  // the gap at 5 keep them from joining 1 and 2, and each other.
+  const std::vector<Tether> tethers = {{1, 0, 0.1}, {1, 5, 0.2}, {2, 0, 0.3}, {2, 5, 0.4}, {3, 0, 0.5},
+                                       {4, 0, 0.6}, {4, 5, 0.7}, {6, 0, 0.8}, {6, 5, 0.9}};
+  SolverScratch::Tethers runs;
+  runs.assign(tethers);
+  EXPECT_EQ(runs.run.size(), 4u);
+  EXPECT_EQ(runs.size(), tethers.size());
+  EXPECT_EQ(runs.particles(), 5u);
+  const std::vector<Tether> back = runs.list();
+  ASSERT_EQ(back.size(), tethers.size());
+  for (std::size_t k = 0; k < tethers.size(); ++k) {
+    EXPECT_EQ(back[k].particle, tethers[k].particle);
+    EXPECT_EQ(back[k].pin, tethers[k].pin);
+    EXPECT_EQ(back[k].length, tethers[k].length);
+  }
+}
+
+TEST(Tethers, ThreePinsAlongAnEdgeHoldEveryParticleWithinItsRestDistances) {
+  // A pin in the middle of the top edge splits the particles into runs, and a particle's three
+  // tethers are projected one ball after another (no lens): in one sweep a substep that leaves
+  // under a centimetre (6.9 mm), where without tethers the sheet sags 67 cm past them.
+  const int n = 21;
+  const auto worstExcess = [&](bool tethers) {  // m, beyond a particle's rest distance from a pin
+    WorldSettings settings = test::hangingSheet(n, 1, 1);
+    settings.solver.tethers = tethers;
+    settings.cloths[0].pins.push_back({n / 2, 0, std::nullopt});
+    World world(settings);
+    const Cloth& cloth = world.cloths()[0];
+    EXPECT_EQ(world.tetherCount(), tethers ? 3 * (cloth.state.position.size() - 3) : 0);
+    EXPECT_EQ(world.run(120), StepStatus::ok);
+    Real worst = 0.0;
+    for (const int column : {0, n / 2, n - 1}) {
+      const ParticleIndex pin = cloth.rest.index(column, 0);
+      for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+        worst = std::max(worst, glm::distance(cloth.state.position[i], cloth.state.position[pin]) -
+                                    glm::distance(cloth.rest.restPositions[i], cloth.rest.restPositions[pin]));
+      }
+    }
+    return worst;
+  };
+  const Real tethered = worstExcess(true), free = worstExcess(false);
+  EXPECT_LT(tethered, 0.01);
+  EXPECT_GT(free, 20.0 * tethered);
+}
+
+TEST(Tethers, NoneReachesAcrossACut) {
+  // The two-corner sheet cut in two down the middle, between its pins, before it falls: each half
+  // hangs from its own corner, and the particle next to the cut on the right swings away from the
+  // left pin, farther than it rested from it (a tether left across the cut would hold it there).
+  const int n = 20;
+  WorldSettings settings = test::hangingSheet(n, 1, 4);
+  settings.solver.lines = true;
+  settings.solver.tethers = true;
+  World world(settings);
+  const Cloth& cloth = world.cloths()[0];
+  const std::size_t freeParticles = cloth.state.position.size() - 2;
+  EXPECT_EQ(world.tetherCount(), 2 * freeParticles);
+  ASSERT_EQ(world.cut(Vec3{0.001, 1.5, -0.7}, Vec3{0.001, 1.5, 0.7}, Vec3{0.0, -1.0, 0.0}), 1);
+  ASSERT_EQ(cloth.pieceCount, 2u);
+  EXPECT_EQ(world.tetherCount(), freeParticles);  // each particle keeps the pin of its own half
+  // (The cut splits the particles of column n / 2: each original stays with the left half, and its
+  // copy, which has no tethers, goes with the right.)
+  const ParticleIndex leftPin = cloth.rest.index(0, 0), nextToCut = cloth.rest.index(n / 2 + 1, 0);
+  ASSERT_NE(cloth.piece[nextToCut], cloth.piece[leftPin]);
+  const Real rest = glm::distance(cloth.rest.restPositions[nextToCut], cloth.rest.restPositions[leftPin]);
+  ASSERT_EQ(world.run(120), StepStatus::ok);
+  EXPECT_GT(glm::distance(cloth.state.position[nextToCut], cloth.state.position[leftPin]), rest + 0.1);
+}
+
 TEST(FastSweep, ASecondTearOfAChainBreaksTheLinkThatIsPulled) {
   // A chain of 12 particles 10 cm apart between two pins, soft enough to be pulled past the tearing
   // threshold. Particle 3 is pulled aside: a link at it tears. Then particle 8: a link at it must

@@ -106,11 +106,6 @@ void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inve
 
 namespace {
 
-bool tetherActive(const ParticleState& s, const SolverScratch::Tether& t) {
-  // The anchor was let go, or a finger holds the particle (then the finger decides where it is).
-  return s.inverseMass[t.pin] == 0.0 && s.inverseMass[t.particle] != 0.0;
-}
-
 // Onto the ball of radius r around c, if outside it.
 Vec3 intoBall(Vec3 x, Vec3 c, Real r) {
   const Vec3 d = x - c;
@@ -186,29 +181,44 @@ Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
   return centre + off * (rho / offLength);
 }
 
-// The tethers [begin, end), widened or narrowed to whole particles (a particle's tethers are
-// consecutive and projected together).
-void projectTethers(ParticleState& s, const std::vector<SolverScratch::Tether>& tethers, std::size_t begin,
-                    std::size_t end) {
-  const auto sameParticle = [&](std::size_t k) { return tethers[k].particle == tethers[k - 1].particle; };
-  while (begin > 0 && begin < tethers.size() && sameParticle(begin)) ++begin;
-  while (end > 0 && end < tethers.size() && sameParticle(end)) ++end;
+// The tethered particles [begin, end) (counted over the runs, in order). A tether holds while its
+// pin is pinned (not let go) and nothing holds its particle (a finger then decides where it is).
+// A particle is never a pin while it is projected (its inverse mass is not 0), so each one reads
+// and writes only its own position.
+void projectTethers(ParticleState& s, const SolverScratch::Tethers& tethers, std::size_t begin, std::size_t end) {
+  const std::vector<SolverScratch::Tethers::Run>& runs = tethers.run;
+  std::size_t r = static_cast<std::size_t>(
+      std::upper_bound(runs.begin(), runs.end(), begin, [](std::size_t i, const auto& run) { return i < run.before; }) -
+      runs.begin() - 1);
+  const Real* w = s.inverseMass.data();
+  Vec3* x = s.position.data();
   PinAxis axis;  // pins do not move while tethers are projected
-  for (std::size_t k = begin; k < end;) {
-    const ParticleIndex particle = tethers[k].particle;
-    std::size_t last = k + 1;
-    while (last < tethers.size() && tethers[last].particle == particle) ++last;
-    if (last - k == 2 && tetherActive(s, tethers[k]) && tetherActive(s, tethers[k + 1])) {
-      const Vec3 a = s.position[tethers[k].pin], b = s.position[tethers[k + 1].pin];
-      axis.update(tethers[k].pin, tethers[k + 1].pin, a, b);
-      s.position[particle] = intoLens(s.position[particle], a, tethers[k].length, b, tethers[k + 1].length, axis);
-    } else {
-      for (std::size_t j = k; j < last; ++j) {
-        const SolverScratch::Tether& t = tethers[j];
-        if (tetherActive(s, t)) s.position[particle] = intoBall(s.position[particle], s.position[t.pin], t.length);
+  for (; r < runs.size() && runs[r].before < end; ++r) {
+    const SolverScratch::Tethers::Run& run = runs[r];
+    const ParticleIndex* pin = tethers.pin.data() + run.pins;
+    const std::size_t from = std::max(begin, std::size_t{run.before}) - run.before;
+    const std::size_t to = std::min(end, std::size_t{run.before} + run.count) - run.before;
+    bool allPinned = true;
+    for (std::uint32_t j = 0; j < run.pinCount; ++j) allPinned = allPinned && w[pin[j]] == 0.0;
+    if (run.pinCount == 2 && allPinned) {
+      const Vec3 a = x[pin[0]], b = x[pin[1]];
+      axis.update(pin[0], pin[1], a, b);
+      for (std::size_t i = from; i < to; ++i) {
+        const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
+        if (w[particle] == 0.0) continue;
+        const Real* length = tethers.length.data() + run.lengths + 2 * i;
+        x[particle] = intoLens(x[particle], a, length[0], b, length[1], axis);
+      }
+      continue;
+    }
+    for (std::size_t i = from; i < to; ++i) {
+      const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
+      if (w[particle] == 0.0) continue;
+      const Real* length = tethers.length.data() + run.lengths + i * run.pinCount;
+      for (std::uint32_t j = 0; j < run.pinCount; ++j) {
+        if (w[pin[j]] == 0.0) x[particle] = intoBall(x[particle], x[pin[j]], length[j]);
       }
     }
-    k = last;
   }
 }
 
@@ -244,7 +254,7 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
       projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
     }
   }
-  if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers, 0, scratch.tethers.size());
+  if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers, 0, scratch.tethers.particles());
 }
 
 // The fast sweep (solver.lines): tethers first, then bend and shear in batches shared among the
@@ -255,7 +265,7 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
   ParticleState& s = cloth.state;
   const auto tethers = [&] {
     if (scratch.tethers.empty()) return;
-    workers.run(scratch.tethers.size(),
+    workers.run(scratch.tethers.particles(),
                 [&](std::size_t begin, std::size_t end, int) { projectTethers(s, scratch.tethers, begin, end); });
   };
   tethers();

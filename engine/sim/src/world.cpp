@@ -210,15 +210,17 @@ void World::buildTethers(std::size_t c) {
     if (cloth.state.pinned[p]) pins.push_back(p);
   }
   // Particle by particle, so that a particle's tethers are consecutive and projected together.
+  std::vector<SolverScratch::Tethers::Tether> tethers;
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
     if (cloth.state.inverseMass[i] == 0.0) continue;
     for (const std::size_t p : pins) {
       if (cloth.piece[i] != cloth.piece[p]) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
       const Real length = glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]);
-      scratch_[c].tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
+      tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
     }
   }
+  scratch_[c].tethers.assign(tethers);
 }
 
 void World::buildPipeline() {
@@ -344,7 +346,7 @@ MemoryUse World::memoryUse() const {
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
                 bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.looseStretch) + bytes(s.lineNormal) +
                 bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart);
-    m.tethers += bytes(s.tethers);
+    m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
       m.lines += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda) + bytes(f.tension) +
                  bytes(f.tensionSum) + bytes(f.taut) + bytes(f.order);
@@ -732,8 +734,9 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   grow(scratch.sumVelocity, n);
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
   // A tether may not reach across a tear.
-  std::erase_if(scratch.tethers,
-                [&](const SolverScratch::Tether& t) { return cloth.piece[t.particle] != cloth.piece[t.pin]; });
+  std::vector<SolverScratch::Tethers::Tether> tethers = scratch.tethers.list();
+  std::erase_if(tethers, [&](const auto& t) { return cloth.piece[t.particle] != cloth.piece[t.pin]; });
+  scratch.tethers.assign(tethers);
   topologyVersion_ = nextTopologyVersion();
 }
 

@@ -39,13 +39,37 @@ struct SolverScratch {
   std::vector<Real> contactDepth;   // m, penetration resolved this substep (for friction)
   // XPBD: the Lagrange multiplier of every constraint, by kind, reset each substep.
   std::array<std::vector<Real>, kConstraintKindCount> lambda;
-  // Tethers: particle, pinned particle, the longest they may be apart (m).
-  struct Tether {
-    ParticleIndex particle;
-    ParticleIndex pin;
-    Real length;
+  // Tethers (solver.tethers): each free particle may be no farther from each pin of its piece than
+  // at rest. Kept in runs of consecutive particles tied to the same pins: a run lists its pins once
+  // and each of its particles only its lengths (on hang2 that is 16 bytes a particle, not 32).
+  struct Tethers {
+    struct Tether {  // one, as they are built and filtered (list, assign)
+      ParticleIndex particle;
+      ParticleIndex pin;
+      Real length;  // m, the longest they may be apart
+    };
+    struct Run {
+      ParticleIndex first;  // particles first .. first + count
+      std::uint32_t count;
+      std::uint32_t pins;  // pin[pins .. pins + pinCount)
+      std::uint32_t pinCount;
+      std::uint32_t lengths;  // particle first + i to pin j: length[lengths + i * pinCount + j]
+      std::uint32_t before;   // particles in the runs before this one
+    };
+    std::vector<Run> run;
+    std::vector<ParticleIndex> pin;
+    std::vector<Real> length;
+
+    bool empty() const { return run.empty(); }
+    std::size_t size() const { return length.size(); }  // tethers
+    std::size_t particles() const { return run.empty() ? 0 : run.back().before + run.back().count; }
+    void clear() { *this = {}; }
+    // The tethers one by one, in particle order, a particle's in its run's pin order.
+    std::vector<Tether> list() const;
+    // From tethers sorted by particle (a particle's consecutive).
+    void assign(const std::vector<Tether>& tethers);
   };
-  std::vector<Tether> tethers;
+  Tethers tethers;
   // Lines (solver.lines): the stretch constraints as chains, rows and columns on a lattice, each
   // solved at once (lines.hpp). Built from the constraints whenever they change.
   struct LineFamily {
