@@ -283,6 +283,29 @@ TEST(Workers, EveryItemIsVisitedOnceWhateverTheThreads) {
   }
 }
 
+TEST(Workers, DealtBlocksVisitEveryItemOnceAndGiveEachThreadAShareOfEveryPart) {
+  for (int threads : {1, 2, 3}) {
+    Workers workers(threads);
+    for (std::size_t n : {std::size_t{0}, std::size_t{5}, std::size_t{10007}}) {
+      std::vector<int> visits(n, 0), owner(n, -1);
+      workers.runDealt(
+          n, 100,
+          [&](std::size_t begin, std::size_t end, int thread) {
+            EXPECT_LE(end - begin, 100u);
+            for (std::size_t i = begin; i < end; ++i) {
+              ++visits[i];
+              owner[i] = thread;
+            }
+          },
+          16);
+      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(visits[i], 1) << threads << " threads, n = " << n;
+      if (n < 10000) continue;
+      // Block b goes to part b % parts: each thread works in the first tenth and in the last.
+      for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(owner[i], static_cast<int>(i / 100 % threads)) << i;
+    }
+  }
+}
+
 TEST(Workers, LoopsOfFewerPartsThanThreadsUseOnlyTheirHelpers) {
   // 8 threads, loops cut into 2, 3, 8 and 1 parts in turn, thousands of times. The caller waits only
   // for the helpers a loop uses, so the others may still be catching up with an earlier loop as the

@@ -37,24 +37,36 @@ Workers::~Workers() {
   for (std::thread& helper : helpers_) helper.join();
 }
 
-void Workers::dispatch(std::size_t n, std::size_t grain, Call call, void* task) {
+void Workers::part(Call call, void* task, std::size_t n, std::size_t block, int parts, int index) {
+  if (block == 0) {
+    const auto [begin, end] = chunk(n, parts, index);
+    call(task, begin, end, index);
+    return;
+  }
+  const std::size_t stride = block * static_cast<std::size_t>(parts);
+  for (std::size_t begin = block * static_cast<std::size_t>(index); begin < n; begin += stride) {
+    call(task, begin, std::min(begin + block, n), index);
+  }
+}
+
+void Workers::dispatch(std::size_t n, std::size_t grain, std::size_t block, Call call, void* task) {
   const int parts = static_cast<int>(std::min<std::size_t>(
       static_cast<std::size_t>(threads()), std::max<std::size_t>(n / std::max<std::size_t>(grain, 1), 1)));
   if (parts <= 1) {
-    call(task, 0, n, 0);
+    part(call, task, n, block, 1, 0);
     return;
   }
   call_ = call;
   task_ = task;
   items_ = n;
+  block_ = block;
   pending_.store(parts - 1, std::memory_order_relaxed);
   const std::uint64_t loop = state_.load(std::memory_order_relaxed) / kStateParts + 1;
   state_.store(loop * kStateParts + static_cast<std::uint64_t>(parts), std::memory_order_release);
   state_.notify_all();
-  const auto [begin, end] = chunk(n, parts, 0);
   std::exception_ptr failure;
   try {
-    call(task, begin, end, 0);
+    part(call, task, n, block, parts, 0);
   } catch (...) {
     failure = std::current_exception();
   }
@@ -86,9 +98,8 @@ void Workers::loop(int index) {
     // Not taking part: nothing of the loop is read (the caller may already be setting up the next).
     const int parts = static_cast<int>(now % kStateParts);
     if (index >= parts) continue;
-    const auto [begin, end] = chunk(items_, parts, index);
     try {
-      call_(task_, begin, end, index);
+      part(call_, task_, items_, block_, parts, index);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(failureMutex_);
       if (!failure_) failure_ = std::current_exception();

@@ -1,7 +1,8 @@
 // A fixed team of threads for the solver's parallel loops.
 //
 // run(n, f) splits [0, n) into one contiguous chunk per thread, calls f(begin, end, thread) on
-// each (chunk 0 on the caller) and returns when all are done. The solver only hands it work whose
+// each (chunk 0 on the caller) and returns when all are done (runDealt deals out short blocks
+// instead). The solver only hands it work whose
 // items are independent (a batch of constraints no two of which share a particle, lines, single
 // particles), so the result is the same bit for bit whatever the number of threads. Helpers spin
 // briefly between loops (a substep has a dozen of them), then sleep. A loop cut into fewer parts
@@ -10,6 +11,7 @@
 // pool stays usable.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -33,18 +35,27 @@ class Workers {
   // f(begin, end, thread); it is not copied (no allocation per loop).
   template <class F>
   void run(std::size_t n, F&& f, std::size_t grain = 512) {
-    using Task = std::remove_reference_t<F>;
-    dispatch(
-        n, grain,
-        [](void* task, std::size_t begin, std::size_t end, int thread) {
-          (*static_cast<Task*>(task))(begin, end, thread);
-        },
-        static_cast<void*>(&f));
+    dispatch(n, grain, 0, caller<F>(), static_cast<void*>(&f));
+  }
+  // As run, but [0, n) is cut into blocks of `block` items dealt out in turn (block b to part
+  // b % parts), f called once a block: for loops whose items cost more in one part of the range than
+  // in another (the tethers of particles near the pins), so that each thread gets its share of each.
+  template <class F>
+  void runDealt(std::size_t n, std::size_t block, F&& f, std::size_t grain = 512) {
+    dispatch(n, grain, std::max<std::size_t>(block, 1), caller<F>(), static_cast<void*>(&f));
   }
 
  private:
   using Call = void (*)(void*, std::size_t, std::size_t, int);
-  void dispatch(std::size_t n, std::size_t grain, Call call, void* task);
+  template <class F>
+  static Call caller() {
+    return [](void* task, std::size_t begin, std::size_t end, int thread) {
+      (*static_cast<std::remove_reference_t<F>*>(task))(begin, end, thread);
+    };
+  }
+  void dispatch(std::size_t n, std::size_t grain, std::size_t block, Call call, void* task);
+  // Part `index` of `parts` of the loop of n items.
+  static void part(Call call, void* task, std::size_t n, std::size_t block, int parts, int index);
   void loop(int index);
   std::vector<std::thread> helpers_;
   // The current loop. Written only while no helper uses them: before a loop is announced, and after
@@ -52,6 +63,7 @@ class Workers {
   Call call_ = nullptr;
   void* task_ = nullptr;
   std::size_t items_ = 0;
+  std::size_t block_ = 0;  // 0: each part one contiguous chunk; else dealt out in blocks this long
   // The loop's number times kStateParts, plus the threads taking part in it (the caller and helpers
   // 1 .. parts - 1): one word, so a helper never pairs one loop's number with another's parts.
   static constexpr std::uint64_t kStateParts = 128;
