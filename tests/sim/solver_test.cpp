@@ -283,25 +283,24 @@ TEST(Workers, EveryItemIsVisitedOnceWhateverTheThreads) {
   }
 }
 
-TEST(Workers, DealtBlocksVisitEveryItemOnceAndGiveEachThreadAShareOfEveryPart) {
-  for (int threads : {1, 2, 3}) {
+TEST(Workers, SharedBlocksVisitEveryItemOnceWhateverTheThreads) {
+  for (int threads : {1, 2, 3, 8}) {
     Workers workers(threads);
     for (std::size_t n : {std::size_t{0}, std::size_t{5}, std::size_t{10007}}) {
-      std::vector<int> visits(n, 0), owner(n, -1);
-      workers.runDealt(
-          n, 100,
-          [&](std::size_t begin, std::size_t end, int thread) {
-            EXPECT_LE(end - begin, 100u);
-            for (std::size_t i = begin; i < end; ++i) {
-              ++visits[i];
-              owner[i] = thread;
-            }
-          },
-          16);
-      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(visits[i], 1) << threads << " threads, n = " << n;
-      if (n < 10000) continue;
-      // Block b goes to part b % parts: each thread works in the first tenth and in the last.
-      for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(owner[i], static_cast<int>(i / 100 % threads)) << i;
+      for (int round = 0; round < 50; ++round) {
+        std::vector<int> visits(n, 0);
+        std::atomic<std::size_t> calls{0};
+        workers.runShared(
+            n, 100,
+            [&](std::size_t begin, std::size_t end, int) {
+              EXPECT_TRUE(begin % 100 == 0 && end - begin <= 100 && end <= n) << begin << " " << end;
+              for (std::size_t i = begin; i < end; ++i) ++visits[i];
+              calls.fetch_add(1);
+            },
+            16);
+        for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(visits[i], 1) << threads << " threads, n = " << n;
+        EXPECT_EQ(calls.load(), (n + 99) / 100);  // once a block
+      }
     }
   }
 }

@@ -506,8 +506,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     const std::size_t perLine = std::max<std::size_t>(lines.particle.size() / count, 1);
     const std::size_t grain = std::max<std::size_t>(2048 / perLine, 1);
     // The lines taut enough to need the full step (needsFullStep) are solved first, then the
-    // others: each share split evenly among the workers, since a full step costs about twice a
-    // tridiagonal one and the taut lines bunch together (near the pins).
+    // others, each share taken by the workers in blocks: a full step costs about twice a
+    // tridiagonal one, and the taut lines bunch together (near the pins).
     lines.order.resize(count);
     std::size_t taut = 0;
     if (fullStep) {
@@ -532,8 +532,9 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     for (const bool stiff : {true, false}) {
       const std::size_t from = stiff ? 0 : taut, to = stiff ? taut : count;
       if (from == to) continue;
-      workers.run(
-          to - from,
+      // Eight lines a block (whole groups for the vector solves), taken by whichever thread is free.
+      workers.runShared(
+          to - from, 8,
           [&](std::size_t first, std::size_t last, int thread) {
             const Real alpha = xpbd ? alphaTilde : 0.0;
             const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);

@@ -265,11 +265,11 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
   ParticleState& s = cloth.state;
   const auto tethers = [&] {
     if (scratch.tethers.empty()) return;
-    // Dealt out in blocks: the particles near the pins cost more (they are on a sphere, and the rest
-    // inside both balls); on hang2 256 the first half of the sheet took 2.6 times as long as the
-    // second.
-    workers.runDealt(scratch.tethers.particles(), 512,
-                     [&](std::size_t begin, std::size_t end, int) { projectTethers(s, scratch.tethers, begin, end); });
+    // Shared out in blocks: the particles near the pins cost more (they are on a sphere, and the
+    // rest inside both balls); on hang2 256 the first half of the sheet took 2.6 times as long as
+    // the second.
+    workers.runShared(scratch.tethers.particles(), 512,
+                      [&](std::size_t begin, std::size_t end, int) { projectTethers(s, scratch.tethers, begin, end); });
   };
   tethers();
   for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
@@ -307,7 +307,8 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
       if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
         body(begin, end);  // its constraints may share particles: one thread, one after another
       } else {
-        workers.run(end - begin, [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last); });
+        workers.runShared(end - begin, 2048,
+                          [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last); });
       }
     }
   }

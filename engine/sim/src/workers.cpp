@@ -43,8 +43,11 @@ void Workers::part(Call call, void* task, std::size_t n, std::size_t block, int 
     call(task, begin, end, index);
     return;
   }
-  const std::size_t stride = block * static_cast<std::size_t>(parts);
-  for (std::size_t begin = block * static_cast<std::size_t>(index); begin < n; begin += stride) {
+  if (parts == 1) {
+    for (std::size_t begin = 0; begin < n; begin += block) call(task, begin, std::min(begin + block, n), index);
+    return;
+  }
+  for (std::size_t begin; (begin = nextBlock_.fetch_add(block, std::memory_order_relaxed)) < n;) {
     call(task, begin, std::min(begin + block, n), index);
   }
 }
@@ -60,6 +63,7 @@ void Workers::dispatch(std::size_t n, std::size_t grain, std::size_t block, Call
   task_ = task;
   items_ = n;
   block_ = block;
+  nextBlock_.store(0, std::memory_order_relaxed);  // published by the release store below
   pending_.store(parts - 1, std::memory_order_relaxed);
   const std::uint64_t loop = state_.load(std::memory_order_relaxed) / kStateParts + 1;
   state_.store(loop * kStateParts + static_cast<std::uint64_t>(parts), std::memory_order_release);

@@ -1,7 +1,7 @@
 // A fixed team of threads for the solver's parallel loops.
 //
 // run(n, f) splits [0, n) into one contiguous chunk per thread, calls f(begin, end, thread) on
-// each (chunk 0 on the caller) and returns when all are done (runDealt deals out short blocks
+// each (chunk 0 on the caller) and returns when all are done (runShared hands out short blocks
 // instead). The solver only hands it work whose
 // items are independent (a batch of constraints no two of which share a particle, lines, single
 // particles), so the result is the same bit for bit whatever the number of threads. Helpers spin
@@ -37,11 +37,12 @@ class Workers {
   void run(std::size_t n, F&& f, std::size_t grain = 512) {
     dispatch(n, grain, 0, caller<F>(), static_cast<void*>(&f));
   }
-  // As run, but [0, n) is cut into blocks of `block` items dealt out in turn (block b to part
-  // b % parts), f called once a block: for loops whose items cost more in one part of the range than
-  // in another (the tethers of particles near the pins), so that each thread gets its share of each.
+  // As run, but [0, n) is cut into blocks of `block` items that the threads take in turn from a
+  // shared counter, each as soon as it is done with the last, f called once a block: for loops
+  // whose items cost more in one part of the range than in another (the tethers of particles near
+  // the pins), or whose threads run at different speeds (a core shared with another machine).
   template <class F>
-  void runDealt(std::size_t n, std::size_t block, F&& f, std::size_t grain = 512) {
+  void runShared(std::size_t n, std::size_t block, F&& f, std::size_t grain = 512) {
     dispatch(n, grain, std::max<std::size_t>(block, 1), caller<F>(), static_cast<void*>(&f));
   }
 
@@ -55,7 +56,7 @@ class Workers {
   }
   void dispatch(std::size_t n, std::size_t grain, std::size_t block, Call call, void* task);
   // Part `index` of `parts` of the loop of n items.
-  static void part(Call call, void* task, std::size_t n, std::size_t block, int parts, int index);
+  void part(Call call, void* task, std::size_t n, std::size_t block, int parts, int index);
   void loop(int index);
   std::vector<std::thread> helpers_;
   // The current loop. Written only while no helper uses them: before a loop is announced, and after
@@ -63,7 +64,8 @@ class Workers {
   Call call_ = nullptr;
   void* task_ = nullptr;
   std::size_t items_ = 0;
-  std::size_t block_ = 0;  // 0: each part one contiguous chunk; else dealt out in blocks this long
+  std::size_t block_ = 0;                  // 0: each part one contiguous chunk; else blocks this long, taken in turn
+  std::atomic<std::size_t> nextBlock_{0};  // runShared: the first item no thread has taken
   // The loop's number times kStateParts, plus the threads taking part in it (the caller and helpers
   // 1 .. parts - 1): one word, so a helper never pairs one loop's number with another's parts.
   static constexpr std::uint64_t kStateParts = 128;
