@@ -131,6 +131,50 @@ TEST(Lines, OnlyATautLineTakesTheFullNewtonStep) {
   EXPECT_GT(largest, 1e-6);
 }
 
+TEST(Lines, TheStiffSolveGivesTheSameBitsEightLinesAtATimeAsFour) {
+  // Where the CPU has AVX the full Newton step solves eight lines side by side (lines_wide.cpp,
+  // built for AVX), else four: every lane's arithmetic must be the same. A 13 x 13 sheet (groups of
+  // 8 + 4 + 1 lines against 4 + 4 + 4 + 1), jittered, every line taut with its own tension, two
+  // particles held, two sweeps.
+  if (stiffSolveLanes() != 8) GTEST_SKIP() << "this CPU has no AVX: the solve takes four lines alone";
+  const auto solved = [](std::size_t lanes) {
+    World world(test::hangingSheet(13, 1, 1));
+    Cloth cloth = world.cloths()[0];
+    std::mt19937 random(11);
+    std::uniform_real_distribution<Real> jitter(-0.01, 0.01);
+    for (Vec3& x : cloth.state.position) x += Vec3{jitter(random), jitter(random), jitter(random)};
+    for (const ParticleIndex held : {cloth.rest.index(6, 6), cloth.rest.index(3, 9)})
+      cloth.state.inverseMass[held] = 0.0;
+    SolverScratch scratch;
+    lines::build(cloth, scratch, 1);
+    EXPECT_EQ(scratch.stiffLanes, 8u);
+    scratch.stiffLanes = lanes;
+    scratch.fullStepRatio = 0.0;  // every line takes the full step
+    std::uniform_real_distribution<float> pull(-2e-4f, 0.0f);
+    for (SolverScratch::LineFamily& family : scratch.lines) {
+      family.tension.resize(family.rest.size());
+      for (float& t : family.tension) t = pull(random);
+    }
+    Workers workers(1);
+    std::vector<float> tensions;
+    for (int sweep = 0; sweep < 2; ++sweep) {
+      lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
+      for (const SolverScratch::LineFamily& family : scratch.lines) {
+        tensions.insert(tensions.end(), family.tensionSum.begin(), family.tensionSum.end());
+      }
+      lines::beginSubstep(scratch);
+    }
+    return std::pair{cloth.state.position, tensions};
+  };
+  const auto [narrowPositions, narrowTensions] = solved(4);
+  const auto [widePositions, wideTensions] = solved(8);
+  EXPECT_EQ(widePositions, narrowPositions);
+  EXPECT_EQ(wideTensions, narrowTensions);
+  // And the sheet did move: the comparison is not of two untouched copies.
+  World world(test::hangingSheet(13, 1, 1));
+  EXPECT_NE(widePositions, world.cloths()[0].state.position);
+}
+
 TEST(Lines, TheStiffSolveDoesNotDependOnHowMuchTheClothWeighs) {
   // Scaling every mass and every tension by the same factor changes no move. The single-precision
   // solve works in units of a line's own mass, so a chain of a picogram moves as one of a tonne.

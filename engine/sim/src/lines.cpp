@@ -8,15 +8,11 @@
 #include <numeric>
 #include <type_traits>
 
-#if defined(__AVX__)
-#include <immintrin.h>
-#elif defined(__SSE__)
-#include <xmmintrin.h>
-#endif
-
 #include <glm/geometric.hpp>
 
+#include "lines_wide.hpp"
 #include "position_model.hpp"
+#include "stiff_lanes.hpp"
 
 namespace drape::sim::lines {
 
@@ -100,195 +96,20 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
   }
 }
 
-// Floats side by side, one line's arithmetic in each: four lines in one instruction (SSE, the
-// portable baseline), eight with AVX. The full Newton step runs in single precision: it only has to
-// find the direction the second, double-precision step refines (the links' lengths it leaves are
-// that step's to correct).
-constexpr std::size_t kLanes = SolverScratch::StiffRows::kLanes;
-using Lane = float __attribute__((vector_size(4 * kLanes)));
-using Lanes = SolverScratch::StiffRows::Lanes;
-struct Lane3 {
-  Lane x, y, z;
-};
-struct LaneSym3 {
-  Lane xx, yy, zz, xy, xz, yz;
-};
-Lane load(const Lanes& a) {
-  Lane v;
-  std::memcpy(&v, a.data(), sizeof v);
-  return v;
-}
-void keep(Lanes& a, Lane v) { std::memcpy(a.data(), &v, sizeof v); }
-Lane3 load(const std::array<Lanes, 3>& a) { return {load(a[0]), load(a[1]), load(a[2])}; }
-void keep(std::array<Lanes, 3>& a, const Lane3& v) {
-  keep(a[0], v.x);
-  keep(a[1], v.y);
-  keep(a[2], v.z);
-}
-LaneSym3 load(const std::array<Lanes, 6>& a) {
-  return {load(a[0]), load(a[1]), load(a[2]), load(a[3]), load(a[4]), load(a[5])};
-}
-void keep(std::array<Lanes, 6>& a, const LaneSym3& m) {
-  keep(a[0], m.xx);
-  keep(a[1], m.yy);
-  keep(a[2], m.zz);
-  keep(a[3], m.xy);
-  keep(a[4], m.xz);
-  keep(a[5], m.yz);
-}
-Lane3 operator+(const Lane3& a, const Lane3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Lane3 operator-(const Lane3& a, const Lane3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Lane3 operator*(const Lane3& a, Lane s) { return {a.x * s, a.y * s, a.z * s}; }
-Lane dot(const Lane3& a, const Lane3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-using Mask = std::int32_t __attribute__((vector_size(4 * kLanes)));
-// 1 in the lanes a comparison holds in, else 0.
-Lane ones(Mask holds) {
-  const Lane one = Lane{} + 1.0f;
-  return std::bit_cast<Lane>(holds & std::bit_cast<Mask>(one));
-}
-// a where the comparison holds, else b.
-Lane select(Mask holds, Lane a, Lane b) {
-  return std::bit_cast<Lane>((holds & std::bit_cast<Mask>(a)) | (~holds & std::bit_cast<Mask>(b)));
-}
-Lane squareRoot(Lane a) {
-#if defined(__AVX__)
-  return _mm256_sqrt_ps(a);
-#elif defined(__SSE__)
-  return _mm_sqrt_ps(a);
+// The full Newton step runs in single precision, lines side by side in vector lanes
+// (stiff_lanes.hpp): eight to an AVX register where the CPU has AVX, else four to an SSE one. It
+// only has to find the direction the second, double-precision step refines (the links' lengths it
+// leaves are that step's to correct).
+bool cpuHasAvx() {
+#if (defined(__x86_64__) || defined(__i386__)) && defined(DRAPE_WIDE_LANES)
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx") != 0;  // and the system saves its registers
+  }();
+  return has;
 #else
-  for (std::size_t lane = 0; lane < kLanes; ++lane) a[lane] = std::sqrt(a[lane]);
-  return a;
+  return false;
 #endif
-}
-Lane3 operator*(const LaneSym3& m, const Lane3& u) {
-  return {m.xx * u.x + m.xy * u.y + m.xz * u.z, m.xy * u.x + m.yy * u.y + m.yz * u.z,
-          m.xz * u.x + m.yz * u.y + m.zz * u.z};
-}
-LaneSym3 operator+(const LaneSym3& a, const LaneSym3& b) {
-  return {a.xx + b.xx, a.yy + b.yy, a.zz + b.zz, a.xy + b.xy, a.xz + b.xz, a.yz + b.yz};
-}
-LaneSym3 operator*(const LaneSym3& a, Lane s) { return {a.xx * s, a.yy * s, a.zz * s, a.xy * s, a.xz * s, a.yz * s}; }
-// s (I - u u^T)
-LaneSym3 across(const Lane3& u, Lane s) {
-  return {(1.0f - u.x * u.x) * s, (1.0f - u.y * u.y) * s, (1.0f - u.z * u.z) * s,
-          -u.x * u.y * s,         -u.x * u.z * s,         -u.y * u.z * s};
-}
-LaneSym3 outer(const Lane3& u) { return {u.x * u.x, u.y * u.y, u.z * u.z, u.x * u.y, u.x * u.z, u.y * u.z}; }
-// u v^T + v u^T
-LaneSym3 outer(const Lane3& u, const Lane3& v) {
-  return {2.0f * u.x * v.x,      2.0f * u.y * v.y,      2.0f * u.z * v.z,
-          u.x * v.y + u.y * v.x, u.x * v.z + u.z * v.x, u.y * v.z + u.z * v.y};
-}
-[[gnu::always_inline]] inline LaneSym3 inverse(const LaneSym3& a) {
-  const Lane cxx = a.yy * a.zz - a.yz * a.yz, cxy = a.xz * a.yz - a.xy * a.zz, cxz = a.xy * a.yz - a.xz * a.yy;
-  const Lane inv = 1.0f / (a.xx * cxx + a.xy * cxy + a.xz * cxz);
-  return {cxx * inv, (a.xx * a.zz - a.xz * a.xz) * inv, (a.xx * a.yy - a.xy * a.xy) * inv, cxy * inv,
-          cxz * inv, (a.xy * a.xz - a.xx * a.yz) * inv};
-}
-
-// A link as the solve uses it: its direction, geometric stiffness g, value C + alpha~ lambda, and 1
-// if the solve corrects it (else 0).
-struct Link {
-  Lane3 unit;
-  Lane pull, rhs, live;
-};
-
-// Link j from what solveStiffLines gathered into row j: the difference of its particles (in nx, ny,
-// nz), its rest length less alpha~ lambda (rhs), its tension over the unit mass (g) and 1 if
-// anything can move it (live). A link with no direction is dead. Keeps in the row what the back
-// substitution reads again: the direction and g.
-Link normalise(SolverScratch::StiffRows& r) {
-  const Lane3 d{load(r.nx), load(r.ny), load(r.nz)};
-  const Lane length2 = dot(d, d);
-  const Lane live = load(r.live) * ones(length2 > 1e-20f);
-  const Lane length = squareRoot(length2 * live + (1.0f - live));  // 1 where dead
-  const Lane inverseLength = live / length;
-  const Link link{d * inverseLength, load(r.g) * inverseLength, (length - load(r.rhs)) * live, live};
-  keep(r.nx, link.unit.x);
-  keep(r.ny, link.unit.y);
-  keep(r.nz, link.unit.z);
-  keep(r.g, link.pull);
-  return link;
-}
-
-// The elimination of solveStiffLines for the kLanes lanes of rows[0, n), gathered. On return each
-// row's yx holds its particle's move and yl its link-before's multiplier.
-void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTilde) {
-  using Row = SolverScratch::StiffRows;
-  const auto direction = [](const Row& r) { return Lane3{load(r.nx), load(r.ny), load(r.nz)}; };
-  const Lane zero{}, one = zero + 1.0f;
-  // Forward. P is the last node's (S^-1)_xx, zx its (S^-1 y)_x: what it passes on through the link.
-  LaneSym3 P;
-  Lane3 zx{zero, zero, zero};
-  Link next = normalise(rows[0]);
-  LaneSym3 nextAcross = across(next.unit, next.pull);  // G of the link after the node
-  {
-    Row& r = rows[0];
-    const Lane m = load(r.mass);
-    const LaneSym3 inverseA = inverse(LaneSym3{m, m, m, zero, zero, zero} + nextAcross) * load(r.moves);
-    keep(r.inverse, inverseA);
-    P = inverseA;
-    keep(r.v, zx);
-    keep(r.b, zx);
-    keep(r.yx, zx);
-    keep(r.schur, one);
-    keep(r.yl, zero);
-  }
-  for (std::size_t j = 1; j < n; ++j) {
-    const Link link = next;  // joins particle j - 1 to j
-    const LaneSym3 linkAcross = nextAcross;
-    Row& r = rows[j];
-    next = normalise(r);
-    nextAcross = across(next.unit, next.pull);
-    const Lane3 unit = link.unit;
-    const Lane pull = link.pull, live = link.live;
-    const Lane3 Pn = P * unit;
-    const Lane nPn = dot(unit, Pn);
-    const Lane3 b = (Pn - unit * nPn) * pull - unit;
-    const Lane c = live * (-alphaTilde - nPn) + (1.0f - live);  // a dead link: the row of the identity
-    const Lane nz = dot(unit, zx);
-    const Lane3 yx = (zx - unit * nz) * pull;
-    Lane yl = live * (link.rhs - nz);
-    // A = m I + G_{j-1} + G_j - G_{j-1} P G_{j-1}
-    const Lane m = load(r.mass);
-    const LaneSym3 A = LaneSym3{m, m, m, zero, zero, zero} + linkAcross + nextAcross +
-                       (P + outer(unit, Pn) * -one + outer(unit) * nPn) * (-pull * pull);
-    const LaneSym3 inverseA = inverse(A) * load(r.moves);
-    const Lane3 v = inverseA * b;
-    Lane schur = c - dot(b, v);
-    // Both particles held (or a zero pivot): the link cannot be corrected.
-    const Mask correctable = (schur > 0.0f) | (schur < 0.0f);
-    schur = select(correctable, schur, one);
-    yl = select(correctable, yl, zero);
-    schur = 1.0f / schur;
-    const Lane3 t = inverseA * yx;
-    const Lane zl = (yl - dot(b, t)) * schur;
-    zx = t - v * zl;
-    P = inverseA + outer(v) * schur;
-    keep(r.inverse, inverseA);
-    keep(r.v, v);
-    keep(r.b, b);
-    keep(r.yx, yx);
-    keep(r.schur, schur);
-    keep(r.yl, yl);
-  }
-
-  // Back: particle j's move and link j - 1's multiplier, from node j + 1's.
-  Lane3 ux{zero, zero, zero};
-  Lane ul = zero;
-  for (std::size_t j = n; j-- > 0;) {
-    Row& r = rows[j];
-    Lane3 px = load(r.yx);
-    if (j + 1 < n) {  // minus link j's coupling to node j + 1
-      const Lane3 unit = direction(r);
-      px = px + (ux - unit * dot(unit, ux)) * load(r.g) - unit * ul;
-    }
-    const Lane3 t = load(r.inverse) * px;
-    ul = j > 0 ? (load(r.yl) - dot(load(r.b), t)) * load(r.schur) : zero;
-    ux = t - load(r.v) * ul;
-    keep(r.yx, ux);
-    keep(r.yl, ul);
-  }
 }
 
 // One full Newton step of G lines' projections from where their particles are now, geometric
@@ -301,13 +122,13 @@ void solveStiffLanes(SolverScratch::StiffRows* rows, std::size_t n, Lane alphaTi
 // eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
 // 3 x 3 inverse and a scalar pivot), so a held particle (whose unknowns drop out) never leaves a
 // link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
-// solved by solveStiffLanes kLanes lines at once, and the moves and multipliers scattered back.
-template <std::size_t G>
+// solved by solveStiffLanes W (4 or 8) lines at once, and the moves and multipliers scattered back.
+template <std::size_t W, std::size_t G>
 void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                      const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
                      const std::array<const float*, G>& tension, const std::array<float*, G>& tensionSum, std::size_t n,
                      Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows) {
-  static_assert(G <= kLanes);
+  static_assert(G <= W && W <= SolverScratch::StiffRows::kLanes);
   using Row = SolverScratch::StiffRows;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -316,10 +137,10 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
   // Gathered first: each link's direction, value and geometric stiffness, each particle's mass.
   // Each line's system is solved in units of its first particle's mass (K / s, alpha~ s, l / s,
   // s = that mass), so that single precision holds whatever the cloth weighs.
-  std::array<Real, kLanes> unitMass, perUnitMass;
+  std::array<Real, W> unitMass, perUnitMass;
   unitMass.fill(1.0);
   perUnitMass.fill(1.0);
-  Lanes alpha{};
+  float alpha[W]{};
   for (std::size_t g = 0; g < G; ++g) {
     unitMass[g] = mass[p[g][0]] > 0.0 ? mass[p[g][0]] : 1.0;
     perUnitMass[g] = 1.0 / unitMass[g];
@@ -331,7 +152,7 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
     // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
     // the link's direction, value and geometric stiffness (normalise). Lanes no line fills hold a
     // free particle and no link.
-    for (std::size_t g = 0; g < kLanes; ++g) {
+    for (std::size_t g = 0; g < W; ++g) {
       r.mass[g] = g < G ? static_cast<float>(mass[p[g][k]] * perUnitMass[g]) : 1.0f;
       r.moves[g] = g < G && w[p[g][k]] > 0.0 ? 1.0f : 0.0f;
       r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
@@ -348,10 +169,14 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
     }
   }
   // A held particle or a dead link is masked, not branched on.
-  solveStiffLanes(rows, n, load(alpha));
+  if constexpr (W == 8) {
+    solveStiffLanesWide(rows, n, alpha);
+  } else {
+    solveStiffLanes<Narrow>(rows, n, load<Narrow>(alpha));
+  }
   // A dead link's multiplier comes out 0 and is added all the same; a held particle is not touched
   // (its move is 0 too, but it must stay put even if something upstream went non-finite).
-  std::array<Real, kLanes> multiplierScale{};
+  std::array<Real, W> multiplierScale{};
   for (std::size_t g = 0; g < G; ++g) multiplierScale[g] = unitMass[g] * stiffness;
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
@@ -472,6 +297,7 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
     lines.start.push_back(static_cast<std::uint32_t>(lines.particle.size()));
     lines.lambda.clear();  // sized by the XPBD solve, which alone uses it
   }
+  scratch.stiffLanes = cpuHasAvx() ? 8 : 4;
   scratch.lineStride = longest * 4;  // four lines interleaved
   const std::size_t slices = scratch.lineStride * static_cast<std::size_t>(std::max(threads, 1));
   scratch.lineNormal.assign(slices, Vec3{0.0});
@@ -540,19 +366,25 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
             const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
             const std::uint32_t* line = lines.order.data() + from + first;
             if (stiff) {
-              inGroups<kLanes>(
-                  lines, line, last - first, xpbd,
-                  [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                     const auto& lambda, const auto& offset, std::size_t n) {
-                    std::array<const float*, G> tension{};
-                    std::array<float*, G> tensionSum{};
-                    for (std::size_t g = 0; g < G; ++g) {
-                      tension[g] = lines.tension.data() + offset[g];
-                      tensionSum[g] = lines.tensionSum.data() + offset[g];
-                    }
-                    solveStiffLines<G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                       scratch.lineStiff.data() + slice / 4);
-                  });
+              const auto solveStiff = [&]<std::size_t W>(std::integral_constant<std::size_t, W>) {
+                inGroups<W>(lines, line, last - first, xpbd,
+                            [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
+                                               const auto& lambda, const auto& offset, std::size_t n) {
+                              std::array<const float*, G> tension{};
+                              std::array<float*, G> tensionSum{};
+                              for (std::size_t g = 0; g < G; ++g) {
+                                tension[g] = lines.tension.data() + offset[g];
+                                tensionSum[g] = lines.tensionSum.data() + offset[g];
+                              }
+                              solveStiffLines<W, G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                                    scratch.lineStiff.data() + slice / 4);
+                            });
+              };
+              if (scratch.stiffLanes == 8) {
+                solveStiff(std::integral_constant<std::size_t, 8>{});
+              } else {
+                solveStiff(std::integral_constant<std::size_t, 4>{});
+              }
             } else {
               // With geometric stiffness every solve adds its multipliers to the tension sums.
               inGroups<4>(lines, line, last - first, xpbd,
@@ -599,3 +431,9 @@ void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real
 }
 
 }  // namespace drape::sim::lines
+
+namespace drape::sim {
+
+int stiffSolveLanes() { return lines::cpuHasAvx() ? 8 : 4; }
+
+}  // namespace drape::sim

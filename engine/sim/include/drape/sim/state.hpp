@@ -100,26 +100,23 @@ struct SolverScratch {
   // together, each quantity for those lines side by side, so that the solve runs in vector lanes
   // (single precision, in units of each line's first particle's mass).
   struct StiffRows {
-    // Lines solved side by side: as many floats as a vector register holds (8 with AVX, in a build
-    // for this machine's CPU; else 4, SSE). The layout thus follows the compile flags: everything
-    // that includes this header must be built with the same ones (the project sets them globally).
-#if defined(__AVX__)
+    // Up to 8 lines side by side, an AVX register of floats; the solve takes 8 where the CPU has
+    // AVX (chosen at run time, lines.cpp) and else 4, an SSE register, in the first lanes. Plain
+    // arrays: the AVX solve (lines_wide.cpp, built for AVX) instantiates no library template.
     static constexpr std::size_t kLanes = 8;
-#else
-    static constexpr std::size_t kLanes = 4;
-#endif
-    using Lanes = std::array<float, kLanes>;
-    Lanes nx, ny, nz;              // direction of the link to the next particle
-    Lanes g;                       // its geometric stiffness: G = g (I - n n^T)
-    Lanes rhs;                     // its constraint value, C + alpha~ lambda
-    Lanes live;                    // 1: a link the solve corrects; 0: not
-    Lanes mass, moves;             // the particle's mass, and 1 if it is free to move
-    std::array<Lanes, 6> inverse;  // A^-1 of its eliminated block (symmetric: xx yy zz xy xz yz)
-    std::array<Lanes, 3> v, b, yx;
+    using Lanes = float[kLanes];
+    Lanes nx, ny, nz;   // direction of the link to the next particle
+    Lanes g;            // its geometric stiffness: G = g (I - n n^T)
+    Lanes rhs;          // its constraint value, C + alpha~ lambda
+    Lanes live;         // 1: a link the solve corrects; 0: not
+    Lanes mass, moves;  // the particle's mass, and 1 if it is free to move
+    Lanes inverse[6];   // A^-1 of its eliminated block (symmetric: xx yy zz xy xz yz)
+    Lanes v[3], b[3], yx[3];
     Lanes schur;  // the inverse of the link multiplier's pivot
     Lanes yl;
   };
   std::vector<StiffRows> lineStiff;
+  std::size_t stiffLanes = 4;  // lines the solve takes side by side: 8 where the CPU has AVX (lines::build)
   // Each kind's constraints come in batches that share no particle (batches.hpp): batch b is
   // [batchStart[b], batchStart[b + 1]); with sequentialTail the last batch is not one.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;

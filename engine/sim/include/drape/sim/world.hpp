@@ -69,6 +69,11 @@ struct MemoryUse {
 
 inline constexpr int kMaxThreads = 64;
 
+// How many lines the full Newton line step (solver.geometricStiffness) solves side by side on this
+// CPU: 8 where it has AVX (chosen at run time, in the portable build too), else 4. The results are
+// the same bit for bit either way.
+int stiffSolveLanes();
+
 class World {
  public:
   // Throws std::invalid_argument if the settings are outside what the engine accepts.
