@@ -122,13 +122,14 @@ bool cpuHasAvx() {
 // eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
 // 3 x 3 inverse and a scalar pivot), so a held particle (whose unknowns drop out) never leaves a
 // link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
-// solved by solveStiffLanes W (4 or 8) lines at once, and the moves and multipliers scattered back.
-template <std::size_t W, std::size_t G>
-void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
-                     const std::array<const Real*, G>& rest, const std::array<Real*, G>& lambda,
-                     const std::array<const float*, G>& tension, const std::array<float*, G>& tensionSum, std::size_t n,
+// solved by solveStiffLanes W (4 or 8) lanes at once (the first G filled; the others hold a free
+// particle and no link), and the moves and multipliers scattered back.
+template <std::size_t W>
+void solveStiffLines(ParticleState& s, std::size_t G, const std::array<const ParticleIndex*, W>& p,
+                     const std::array<const Real*, W>& rest, const std::array<Real*, W>& lambda,
+                     const std::array<const float*, W>& tension, const std::array<float*, W>& tensionSum, std::size_t n,
                      Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows) {
-  static_assert(G <= W && W <= SolverScratch::StiffRows::kLanes);
+  static_assert(W <= SolverScratch::StiffRows::kLanes);
   using Row = SolverScratch::StiffRows;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -194,6 +195,7 @@ void solveStiffLines(ParticleState& s, const std::array<const ParticleIndex*, G>
 // else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests,
 // lambdas, offsets, n), each array holding G lines' pointers (lambdas null without XPBD) and
 // offsets their starts. A line's arithmetic does not depend on which lines it is solved beside.
+// (The vector solve takes up to W in a row instead: inLanes.)
 template <std::size_t W, class Solve>
 void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t count, bool xpbd,
               Solve&& solve) {
@@ -223,6 +225,36 @@ void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::
     }
     if (n >= 2) gather(std::integral_constant<std::size_t, 1>{}, i, n);
     ++i;
+  }
+}
+
+// The lines line[0, count) of a family, up to W at a time, as many equally long ones as follow
+// each other: solve(G, particles, rests, lambdas, offsets, n), each array holding W lines'
+// pointers of which the first G are filled (lambdas null without XPBD). A lane left empty costs
+// as much as a filled one, so a short group beats lines one by one.
+template <std::size_t W, class Solve>
+void inLanes(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t count, bool xpbd, Solve&& solve) {
+  const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
+  for (std::size_t i = 0; i < count;) {
+    const std::size_t n = length(i);
+    if (n < 2) {
+      ++i;
+      continue;
+    }
+    std::size_t G = 1;
+    while (G < W && i + G < count && length(i + G) == n) ++G;
+    std::array<const ParticleIndex*, W> p{};
+    std::array<const Real*, W> rest{};
+    std::array<Real*, W> lambda{};
+    std::array<std::size_t, W> offset{};
+    for (std::size_t g = 0; g < G; ++g) {
+      offset[g] = lines.start[line[i + g]];
+      p[g] = lines.particle.data() + offset[g];
+      rest[g] = lines.rest.data() + offset[g];
+      lambda[g] = xpbd ? lines.lambda.data() + offset[g] : nullptr;
+    }
+    solve(G, p, rest, lambda, offset, n);
+    i += G;
   }
 }
 
@@ -367,18 +399,18 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
             const std::uint32_t* line = lines.order.data() + from + first;
             if (stiff) {
               const auto solveStiff = [&]<std::size_t W>(std::integral_constant<std::size_t, W>) {
-                inGroups<W>(lines, line, last - first, xpbd,
-                            [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                               const auto& lambda, const auto& offset, std::size_t n) {
-                              std::array<const float*, G> tension{};
-                              std::array<float*, G> tensionSum{};
-                              for (std::size_t g = 0; g < G; ++g) {
-                                tension[g] = lines.tension.data() + offset[g];
-                                tensionSum[g] = lines.tensionSum.data() + offset[g];
-                              }
-                              solveStiffLines<W, G>(s, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                                    scratch.lineStiff.data() + slice / 4);
-                            });
+                inLanes<W>(lines, line, last - first, xpbd,
+                           [&](std::size_t G, const auto& p, const auto& rest, const auto& lambda, const auto& offset,
+                               std::size_t n) {
+                             std::array<const float*, W> tension{};
+                             std::array<float*, W> tensionSum{};
+                             for (std::size_t g = 0; g < G; ++g) {
+                               tension[g] = lines.tension.data() + offset[g];
+                               tensionSum[g] = lines.tensionSum.data() + offset[g];
+                             }
+                             solveStiffLines<W>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                                scratch.lineStiff.data() + slice / 4);
+                           });
               };
               if (scratch.stiffLanes == 8) {
                 solveStiff(std::integral_constant<std::size_t, 8>{});
