@@ -124,12 +124,14 @@ bool cpuHasAvx() {
 // link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
 // solved by solveStiffLanes W (4 or 8) lanes at once (the first G filled; the others hold a free
 // particle and no link), and the moves and multipliers scattered back.
-template <std::size_t W>
-void solveStiffLines(ParticleState& s, std::size_t G, const std::array<const ParticleIndex*, W>& p,
+// (FixedG: the number of lines G when it is known at compile time, a full group; 0: given as count.)
+template <std::size_t W, std::size_t FixedG>
+void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const ParticleIndex*, W>& p,
                      const std::array<const Real*, W>& rest, const std::array<Real*, W>& lambda,
                      const std::array<const float*, W>& tension, const std::array<float*, W>& tensionSum, std::size_t n,
                      Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows) {
-  static_assert(W <= SolverScratch::StiffRows::kLanes);
+  static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
+  const std::size_t G = FixedG != 0 ? FixedG : count;
   using Row = SolverScratch::StiffRows;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -147,18 +149,28 @@ void solveStiffLines(ParticleState& s, std::size_t G, const std::array<const Par
     perUnitMass[g] = 1.0 / unitMass[g];
     alpha[g] = static_cast<float>(alphaTilde * unitMass[g]);
   }
+  // Each link's difference (in double: the particles' distance from the origin may be a thousand
+  // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
+  // the link's direction, value and geometric stiffness (normalise). Each line's particle at k + 1
+  // is carried over as the next link's first. Lanes no line fills hold a free particle and no link.
+  std::array<Vec3, W> from;
+  std::array<Real, W> fromW;
+  for (std::size_t g = 0; g < G; ++g) {
+    from[g] = x[p[g][0]];
+    fromW[g] = w[p[g][0]];
+  }
   for (std::size_t k = 0; k < n; ++k) {
     Row& r = rows[k];
-    // Each link's difference (in double: the particles' distance from the origin may be a thousand
-    // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
-    // the link's direction, value and geometric stiffness (normalise). Lanes no line fills hold a
-    // free particle and no link.
-    for (std::size_t g = 0; g < W; ++g) {
-      r.mass[g] = g < G ? static_cast<float>(mass[p[g][k]] * perUnitMass[g]) : 1.0f;
-      r.moves[g] = g < G && w[p[g][k]] > 0.0 ? 1.0f : 0.0f;
-      r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
-      if (g >= G || k == links) continue;
-      const Vec3 d = x[p[g][k + 1]] - x[p[g][k]];
+    for (std::size_t g = 0; g < G; ++g) {
+      r.mass[g] = static_cast<float>(mass[p[g][k]] * perUnitMass[g]);
+      r.moves[g] = fromW[g] > 0.0 ? 1.0f : 0.0f;
+      if (k == links) {
+        r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
+        continue;
+      }
+      const Vec3 to = x[p[g][k + 1]];
+      const Real toW = w[p[g][k + 1]];
+      const Vec3 d = to - from[g];
       r.nx[g] = static_cast<float>(d.x);
       r.ny[g] = static_cast<float>(d.y);
       r.nz[g] = static_cast<float>(d.z);
@@ -166,7 +178,13 @@ void solveStiffLines(ParticleState& s, std::size_t G, const std::array<const Par
       r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
       // Pulled links only: a pushed one would make K indefinite.
       r.g[g] = static_cast<float>(std::max(-static_cast<Real>(tension[g][k]), 0.0) * perUnitMass[g]);
-      r.live[g] = w[p[g][k]] + w[p[g][k + 1]] + alphaTilde > 0.0 ? 1.0f : 0.0f;
+      r.live[g] = fromW[g] + toW + alphaTilde > 0.0 ? 1.0f : 0.0f;
+      from[g] = to;
+      fromW[g] = toW;
+    }
+    for (std::size_t g = G; g < W; ++g) {
+      r.mass[g] = 1.0f;
+      r.moves[g] = r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
     }
   }
   // A held particle or a dead link is masked, not branched on.
@@ -341,6 +359,7 @@ void beginSubstep(SolverScratch& scratch) {
   for (SolverScratch::LineFamily& lines : scratch.lines) {
     lines.tension.swap(lines.tensionSum);
     std::fill(lines.tensionSum.begin(), lines.tensionSum.end(), 0.0f);
+    lines.ordered = false;
   }
 }
 
@@ -366,10 +385,10 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     // The lines taut enough to need the full step (needsFullStep) are solved first, then the
     // others, each share taken by the workers in blocks: a full step costs about twice a
     // tridiagonal one, and the taut lines bunch together (near the pins).
-    lines.order.resize(count);
-    std::size_t taut = 0;
-    if (fullStep) {
+    // The tension is the last substep's: the flags and the order hold for the whole substep.
+    if (fullStep && !lines.ordered) {
       lines.taut.resize(count);
+      lines.order.resize(count);
       workers.run(
           count,
           [&](std::size_t first, std::size_t last, int) {
@@ -378,15 +397,20 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
             }
           },
           grain);
+      std::size_t taut = 0;
       for (std::size_t l = 0; l < count; ++l) {
         if (lines.taut[l]) lines.order[taut++] = static_cast<std::uint32_t>(l);
       }
       for (std::size_t l = 0, slack = taut; l < count; ++l) {
         if (!lines.taut[l]) lines.order[slack++] = static_cast<std::uint32_t>(l);
       }
-    } else {
+      lines.tautCount = taut;
+      lines.ordered = true;
+    } else if (!lines.ordered) {  // any order will do: every line takes the tridiagonal step
+      lines.order.resize(count);
       std::iota(lines.order.begin(), lines.order.end(), 0u);
     }
+    const std::size_t taut = fullStep ? lines.tautCount : 0;
     for (const bool stiff : {true, false}) {
       const std::size_t from = stiff ? 0 : taut, to = stiff ? taut : count;
       if (from == to) continue;
@@ -399,18 +423,23 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
             const std::uint32_t* line = lines.order.data() + from + first;
             if (stiff) {
               const auto solveStiff = [&]<std::size_t W>(std::integral_constant<std::size_t, W>) {
-                inLanes<W>(lines, line, last - first, xpbd,
-                           [&](std::size_t G, const auto& p, const auto& rest, const auto& lambda, const auto& offset,
-                               std::size_t n) {
-                             std::array<const float*, W> tension{};
-                             std::array<float*, W> tensionSum{};
-                             for (std::size_t g = 0; g < G; ++g) {
-                               tension[g] = lines.tension.data() + offset[g];
-                               tensionSum[g] = lines.tensionSum.data() + offset[g];
-                             }
-                             solveStiffLines<W>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                                scratch.lineStiff.data() + slice / 4);
-                           });
+                inLanes<W>(
+                    lines, line, last - first, xpbd,
+                    [&](std::size_t G, const auto& p, const auto& rest, const auto& lambda, const auto& offset,
+                        std::size_t n) {
+                      std::array<const float*, W> tension{};
+                      std::array<float*, W> tensionSum{};
+                      for (std::size_t g = 0; g < G; ++g) {
+                        tension[g] = lines.tension.data() + offset[g];
+                        tensionSum[g] = lines.tensionSum.data() + offset[g];
+                      }
+                      StiffRow* rows = scratch.lineStiff.data() + slice / 4;
+                      if (G == W) {
+                        solveStiffLines<W, W>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha, rows);
+                      } else {
+                        solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha, rows);
+                      }
+                    });
               };
               if (scratch.stiffLanes == 8) {
                 solveStiff(std::integral_constant<std::size_t, 8>{});

@@ -81,10 +81,13 @@ struct SolverScratch {
     // tension times h^2, negative when pulled), and over this one so far. Single precision: they
     // only scale the geometric stiffness, and choose which lines take the full step.
     std::vector<float> tension, tensionSum;
-    // Per line: 1 if it takes the full Newton step this step; the lines in the order they are
-    // solved (the taut ones first).
+    // Per line: 1 if it takes the full Newton step this substep; the lines in the order they are
+    // solved (the taut ones first, tautCount of them). Worked out at the substep's first full step
+    // (ordered is false until then: set at lines::beginSubstep, and whenever tension changes).
     std::vector<std::uint8_t> taut;
     std::vector<std::uint32_t> order;
+    std::size_t tautCount = 0;
+    bool ordered = false;
   };
   // solver.geometricStiffness: a line takes the full Newton step where its geometric stiffness
   // reaches this fraction of its particles' mass somewhere, else the tridiagonal one (lines.cpp,
