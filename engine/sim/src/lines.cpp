@@ -209,6 +209,27 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
   }
 }
 
+// Where lines line[0, G) of a family start, and their particles, rest lengths and multipliers
+// (null without XPBD), in arrays of N.
+template <std::size_t N>
+struct LineData {
+  std::array<const ParticleIndex*, N> p{};
+  std::array<const Real*, N> rest{};
+  std::array<Real*, N> lambda{};
+  std::array<std::size_t, N> offset{};
+};
+template <std::size_t N>
+LineData<N> lineData(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t G, bool xpbd) {
+  LineData<N> d;
+  for (std::size_t g = 0; g < G; ++g) {
+    d.offset[g] = lines.start[line[g]];
+    d.p[g] = lines.particle.data() + d.offset[g];
+    d.rest[g] = lines.rest.data() + d.offset[g];
+    d.lambda[g] = xpbd ? lines.lambda.data() + d.offset[g] : nullptr;
+  }
+  return d;
+}
+
 // The lines line[0, count) of a family, W at a time where W in a row are equally long (G = W),
 // else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests,
 // lambdas, offsets, n), each array holding G lines' pointers (lambdas null without XPBD) and
@@ -220,17 +241,8 @@ void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::
   constexpr std::size_t G = W;
   const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
   const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t i, std::size_t n) {
-    std::array<const ParticleIndex*, N> p{};
-    std::array<const Real*, N> rest{};
-    std::array<Real*, N> lambda{};
-    std::array<std::size_t, N> offset{};
-    for (std::size_t g = 0; g < N; ++g) {
-      offset[g] = lines.start[line[i + g]];
-      p[g] = lines.particle.data() + offset[g];
-      rest[g] = lines.rest.data() + offset[g];
-      lambda[g] = xpbd ? lines.lambda.data() + offset[g] : nullptr;
-    }
-    solve(size, p, rest, lambda, offset, n);
+    const LineData<N> d = lineData<N>(lines, line + i, N, xpbd);
+    solve(size, d.p, d.rest, d.lambda, d.offset, n);
   };
   for (std::size_t i = 0; i < count;) {
     const std::size_t n = length(i);
@@ -261,17 +273,8 @@ void inLanes(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::s
     }
     std::size_t G = 1;
     while (G < W && i + G < count && length(i + G) == n) ++G;
-    std::array<const ParticleIndex*, W> p{};
-    std::array<const Real*, W> rest{};
-    std::array<Real*, W> lambda{};
-    std::array<std::size_t, W> offset{};
-    for (std::size_t g = 0; g < G; ++g) {
-      offset[g] = lines.start[line[i + g]];
-      p[g] = lines.particle.data() + offset[g];
-      rest[g] = lines.rest.data() + offset[g];
-      lambda[g] = xpbd ? lines.lambda.data() + offset[g] : nullptr;
-    }
-    solve(G, p, rest, lambda, offset, n);
+    const LineData<W> d = lineData<W>(lines, line + i, G, xpbd);
+    solve(G, d.p, d.rest, d.lambda, d.offset, n);
     i += G;
   }
 }
