@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <numeric>
 #include <type_traits>
 
@@ -122,7 +120,7 @@ bool cpuHasAvx() {
 // eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
 // 3 x 3 inverse and a scalar pivot), so a held particle (whose unknowns drop out) never leaves a
 // link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
-// solved by solveStiffLanes W (4 or 8) lanes at once (the first G filled; the others hold a free
+// solved by solveStiffLanes W (4 or 8) lanes at once (the first G filled; the others hold a held
 // particle and no link), and the moves and multipliers scattered back.
 // (FixedG: the number of lines G when it is known at compile time, a full group; 0: given as count.)
 template <std::size_t W, std::size_t FixedG>
@@ -152,7 +150,7 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
   // Each link's difference (in double: the particles' distance from the origin may be a thousand
   // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
   // the link's direction, value and geometric stiffness (normalise). Each line's particle at k + 1
-  // is carried over as the next link's first. Lanes no line fills hold a free particle and no link.
+  // is carried over as the next link's first. Lanes no line fills hold a held particle and no link.
   std::array<Vec3, W> from;
   std::array<Real, W> fromW;
   for (std::size_t g = 0; g < G; ++g) {

@@ -307,7 +307,10 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
       if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
         body(begin, end);  // its constraints may share particles: one thread, one after another
       } else {
-        workers.runShared(end - begin, 2048,
+        // Blocks of up to 2048 constraints, at least four a thread (hang2 64's batches hold 2000).
+        const std::size_t block =
+            std::clamp<std::size_t>((end - begin) / (4 * static_cast<std::size_t>(workers.threads())), 256, 2048);
+        workers.runShared(end - begin, block,
                           [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last); });
       }
     }

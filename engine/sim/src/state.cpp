@@ -1,7 +1,5 @@
 #include "drape/sim/state.hpp"
 
-#include <algorithm>
-
 namespace drape::sim {
 
 std::vector<SolverScratch::Tethers::Tether> SolverScratch::Tethers::list() const {

@@ -82,8 +82,9 @@ struct SolverScratch {
     // only scale the geometric stiffness, and choose which lines take the full step.
     std::vector<float> tension, tensionSum;
     // Per line: 1 if it takes the full Newton step this substep; the lines in the order they are
-    // solved (the taut ones first, tautCount of them). Worked out at the substep's first full step
-    // (ordered is false until then: set at lines::beginSubstep, and whenever tension changes).
+    // solved (the taut ones first, tautCount of them). Worked out at the substep's first full step:
+    // ordered is cleared by lines::beginSubstep and build, and must be by whatever else writes
+    // tension.
     std::vector<std::uint8_t> taut;
     std::vector<std::uint32_t> order;
     std::size_t tautCount = 0;
@@ -99,7 +100,7 @@ struct SolverScratch {
   std::size_t lineStride = 0;
   std::vector<Vec3> lineNormal;
   std::vector<Real> lineUpper, lineSolution;
-  // ... and of the line solve with geometric stiffness: per particle of kLanes lines solved
+  // ... and of the line solve with geometric stiffness: per particle of the stiffLanes lines solved
   // together, each quantity for those lines side by side, so that the solve runs in vector lanes
   // (single precision, in units of each line's first particle's mass).
   struct StiffRows {
