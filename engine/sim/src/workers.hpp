@@ -4,11 +4,10 @@
 // each (chunk 0 on the caller) and returns when all are done (runShared hands out short blocks
 // instead). The solver only hands it work whose items are independent (a batch of constraints no
 // two of which share a particle, lines, single particles), so the result is the same bit for bit
-// whatever the number of threads. Helpers spin
-// briefly between loops (a substep has a dozen of them), then sleep. A loop cut into fewer parts
-// than there are threads waits only for the helpers it uses. If a part throws (say, bad_alloc), the
-// loop still waits for every part, then rethrows the first exception on the caller's thread; the
-// pool stays usable.
+// whatever the number of threads. Helpers spin briefly between loops (a substep has a dozen of
+// them), then sleep. A loop cut into fewer parts than there are threads waits only for the helpers
+// it uses. If a part throws (say, bad_alloc), the loop still waits for every part, then rethrows
+// the first exception on the caller's thread; the pool stays usable.
 #pragma once
 
 #include <algorithm>

@@ -120,7 +120,9 @@ struct SolverScratch {
     Lanes yl;
   };
   std::vector<StiffRows> lineStiff;
-  std::size_t stiffLanes = 4;  // lines the solve takes side by side: 8 where the CPU has AVX (lines::build)
+  // Lines the solve takes side by side: set by lines::build, 8 where the CPU has AVX, else 4 (kept
+  // here rather than asked of the CPU each step, so a test can solve the same lines both ways).
+  std::size_t stiffLanes = 4;
   // Each kind's constraints come in batches that share no particle (batches.hpp): batch b is
   // [batchStart[b], batchStart[b + 1]); with sequentialTail the last batch is not one.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;
