@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <thread>
 #include <tuple>
 
 #include <glm/geometric.hpp>
@@ -345,6 +347,49 @@ TEST(Workers, SharedBlocksVisitEveryItemOnceWhateverTheThreads) {
         for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(visits[i], 1) << threads << " threads, n = " << n;
         EXPECT_EQ(calls.load(), (n + 99) / 100);  // once a block
       }
+    }
+  }
+}
+
+TEST(Workers, SharedBlocksGoFirstToTheThreadWhoseShareTheyAreIn) {
+  // Each thread's share is the blocks run would give it in one chunk. It takes its own from the
+  // front, in order, then the others' from their backs; thread 0 is made slow so that the others
+  // come to take some of its share.
+  constexpr std::size_t kN = 10007, kBlock = 100, kBlocks = (kN + kBlock - 1) / kBlock;
+  for (int threads : {2, 3}) {
+    Workers workers(threads);
+    for (int round = 0; round < 5; ++round) {
+      std::vector<std::vector<std::size_t>> taken(static_cast<std::size_t>(threads));
+      workers.runShared(
+          kN, kBlock,
+          [&](std::size_t begin, std::size_t, int thread) {
+            if (thread == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
+            taken[static_cast<std::size_t>(thread)].push_back(begin / kBlock);
+          },
+          16);
+      const auto shareOf = [&](std::size_t block) {
+        for (std::size_t i = 0;; ++i) {
+          if (block < kBlocks * (i + 1) / static_cast<std::size_t>(threads)) return i;
+        }
+      };
+      std::size_t total = 0;
+      for (std::size_t t = 0; t < taken.size(); ++t) {
+        total += taken[t].size();
+        const std::size_t first = kBlocks * t / static_cast<std::size_t>(threads);
+        std::size_t own = 0;
+        std::vector<std::size_t> lastFrom(static_cast<std::size_t>(threads), kBlocks);
+        for (std::size_t block : taken[t]) {
+          const std::size_t share = shareOf(block);
+          if (share == t) {
+            EXPECT_EQ(block, first + own) << "thread " << t << ": its own share, from the front, in order";
+            ++own;
+          } else {
+            EXPECT_LT(block, lastFrom[share]) << "thread " << t << ": another's share, from the back";
+            lastFrom[share] = block;
+          }
+        }
+      }
+      EXPECT_EQ(total, kBlocks);
     }
   }
 }

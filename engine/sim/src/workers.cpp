@@ -26,7 +26,7 @@ std::pair<std::size_t, std::size_t> chunk(std::size_t n, int parts, int index) {
 }
 }  // namespace
 
-Workers::Workers(int threads) {
+Workers::Workers(int threads) : shares_(static_cast<std::size_t>(std::max(threads, 1))) {
   for (int i = 1; i < std::max(threads, 1); ++i) helpers_.emplace_back([this, i] { loop(i); });
 }
 
@@ -47,12 +47,27 @@ void Workers::part(Call call, void* task, std::size_t n, std::size_t block, int 
     for (std::size_t begin = 0; begin < n; begin += block) call(task, begin, std::min(begin + block, n), index);
     return;
   }
-  for (std::size_t begin; (begin = nextBlock_.fetch_add(block, std::memory_order_relaxed)) < n;) {
-    call(task, begin, std::min(begin + block, n), index);
+  // The next block of a share, from its front or its back; false when none is left.
+  const auto take = [](Share& share, bool front, std::size_t& taken) {
+    std::uint64_t blocks = share.blocks.load(std::memory_order_relaxed);
+    while (true) {
+      const std::uint64_t first = blocks & 0xffffffffu, last = blocks >> 32;
+      if (first >= last) return false;
+      const std::uint64_t next = front ? blocks + 1 : blocks - (std::uint64_t{1} << 32);
+      if (share.blocks.compare_exchange_weak(blocks, next, std::memory_order_relaxed)) {
+        taken = static_cast<std::size_t>(front ? first : last - 1);
+        return true;
+      }
+    }
+  };
+  for (int i = 0; i < parts; ++i) {
+    Share& share = shares_[static_cast<std::size_t>((index + i) % parts)];
+    for (std::size_t k; take(share, i == 0, k);) call(task, k * block, std::min((k + 1) * block, n), index);
   }
 }
 
 void Workers::dispatch(std::size_t n, std::size_t grain, std::size_t block, Call call, void* task) {
+  if (block != 0) block = std::max<std::size_t>(block, (n >> 32) + 1);  // a share counts blocks in 32 bits
   std::size_t most = std::max<std::size_t>(n / std::max<std::size_t>(grain, 1), 1);
   if (block != 0) most = std::min(most, (n + block - 1) / block);  // no part without a block to take
   const int parts = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(threads()), most));
@@ -64,7 +79,14 @@ void Workers::dispatch(std::size_t n, std::size_t grain, std::size_t block, Call
   task_ = task;
   items_ = n;
   block_ = block;
-  nextBlock_.store(0, std::memory_order_relaxed);  // published by the release store below
+  if (block != 0) {  // published by the release store below
+    const std::uint64_t blocks = (n + block - 1) / block;
+    for (int i = 0; i < parts; ++i) {
+      const std::uint64_t first = blocks * static_cast<std::uint64_t>(i) / static_cast<std::uint64_t>(parts);
+      const std::uint64_t last = blocks * static_cast<std::uint64_t>(i + 1) / static_cast<std::uint64_t>(parts);
+      shares_[static_cast<std::size_t>(i)].blocks.store(first | (last << 32), std::memory_order_relaxed);
+    }
+  }
   pending_.store(parts - 1, std::memory_order_relaxed);
   const std::uint64_t loop = state_.load(std::memory_order_relaxed) / kStateParts + 1;
   state_.store(loop * kStateParts + static_cast<std::uint64_t>(parts), std::memory_order_release);

@@ -36,10 +36,14 @@ class Workers {
   void run(std::size_t n, F&& f, std::size_t grain = 512) {
     dispatch(n, grain, 0, caller<F>(), static_cast<void*>(&f));
   }
-  // As run, but [0, n) is cut into blocks of `block` items that the threads take in turn from a
-  // shared counter, each as soon as it is done with the last, f called once a block: for loops
-  // whose items cost more in one part of the range than in another (the tethers of particles near
-  // the pins), or whose threads run at different speeds (a core shared with another machine).
+  // As run, but [0, n) is cut into blocks of `block` items, f called once a block, and the blocks
+  // go to whichever thread is free: for loops whose items cost more in one part of the range than
+  // in another (the tethers of particles near the pins), or whose threads run at different speeds
+  // (a core shared with another machine). Each thread has a share, the blocks run would give it in
+  // one chunk: it takes its own from the front, then helps the others from their backs. So a thread
+  // works on much the same particles loop after loop, and they stay in its core's cache (on hang2
+  // 256 with 2 threads, taking the blocks in turn from one shared counter made the steps about a
+  // fifth slower).
   template <class F>
   void runShared(std::size_t n, std::size_t block, F&& f, std::size_t grain = 512) {
     dispatch(n, grain, std::max<std::size_t>(block, 1), caller<F>(), static_cast<void*>(&f));
@@ -63,8 +67,13 @@ class Workers {
   Call call_ = nullptr;
   void* task_ = nullptr;
   std::size_t items_ = 0;
-  std::size_t block_ = 0;                  // 0: each part one contiguous chunk; else blocks this long, taken in turn
-  std::atomic<std::size_t> nextBlock_{0};  // runShared: the first item no thread has taken
+  std::size_t block_ = 0;  // 0: each part one contiguous chunk; else blocks this long (runShared)
+  // runShared: each part's own share of the blocks, the ones not yet taken: [front, back), front in
+  // the low 32 bits. A part takes its own from the front, then other parts' from their backs.
+  struct alignas(64) Share {
+    std::atomic<std::uint64_t> blocks{0};
+  };
+  std::vector<Share> shares_;
   // The loop's number times kStateParts, plus the threads taking part in it (the caller and helpers
   // 1 .. parts - 1): one word, so a helper never pairs one loop's number with another's parts.
   static constexpr std::uint64_t kStateParts = 128;
