@@ -1,8 +1,10 @@
 // World-level behaviour: the pipeline a scene gets, determinism, and the divergence guard.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
@@ -77,6 +79,29 @@ TEST(Guard, StopsAtTheFirstNonFiniteStepAndRestoresTheLastGoodState) {
   }
   EXPECT_EQ(world.step(), StepStatus::diverged);  // and it does not step on
   EXPECT_EQ(world.stepCount(), badStep - 1);
+}
+
+TEST(Guard, NamesTheFirstParticleThatRunsAwayWhereverItIs) {
+  // Free particles (no constraints, no pins) of the position model; one, then two of them given a
+  // velocity that takes them past the runaway distance in one step, in different blocks of the
+  // guard's scan (blocks of 256) and on either side of one.
+  WorldSettings settings = test::hangingSheet(30, 1, 1);
+  for (ConstraintKind kind : kConstraintKinds) settings.cloths[0].material(kind) = {0.0, 0.0};
+  settings.cloths[0].pins.clear();
+  for (const std::vector<ParticleIndex>& runaways :
+       std::vector<std::vector<ParticleIndex>>{{700}, {255}, {256}, {899}, {611, 300}, {3, 899}}) {
+    World world(settings);
+    std::vector<Cloth> cloths = world.cloths();
+    ParticleState& s = cloths[0].state;
+    for (ParticleIndex i : runaways) s.previousPosition[i] = s.position[i] - Vec3{0.0, 2.0 * kRunawayDistance, 0.0};
+    world.restoreCloths(cloths);
+    ASSERT_EQ(world.step(), StepStatus::diverged);
+    ASSERT_TRUE(world.divergence().has_value());
+    EXPECT_EQ(world.divergence()->particle, *std::min_element(runaways.begin(), runaways.end()));
+  }
+  // And without them it runs.
+  World calm(settings);
+  EXPECT_EQ(calm.run(10), StepStatus::ok);
 }
 
 TEST(Guard, AStableRunNeverTrips) {

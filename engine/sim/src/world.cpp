@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -22,6 +23,7 @@ namespace drape::sim {
 
 namespace {
 
+constexpr Real kLargest = std::numeric_limits<Real>::max();
 bool finite(Real value) { return std::isfinite(value); }
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -467,17 +469,34 @@ std::optional<Divergence> World::findBadParticle() const {
                glm::abs(x.z) <= kRunawayDistance) ||
              (!s.velocity.empty() && !(glm::length(s.velocity[i]) <= kRunawaySpeed)) || !finite(s.previousPosition[i]);
     };
+    // Without stored velocities, a block at a time first, without branches (vector instructions):
+    // a position within the runaway distance is finite too.
+    const auto blockIsGood = [&](std::size_t begin, std::size_t end) {
+      if (!s.velocity.empty()) return false;
+      bool good = true;
+      for (std::size_t i = begin; i < end; ++i) {
+        const Vec3 x = s.position[i], p = s.previousPosition[i];
+        good &= (std::abs(x.x) <= kRunawayDistance) & (std::abs(x.y) <= kRunawayDistance) &
+                (std::abs(x.z) <= kRunawayDistance) & (std::abs(p.x) <= kLargest) & (std::abs(p.y) <= kLargest) &
+                (std::abs(p.z) <= kLargest);
+      }
+      return good;
+    };
     // The first bad particle, whichever part of the cloth each worker looked at.
     std::atomic<std::size_t> first{s.position.size()};
     workers_->run(
         s.position.size(),
         [&](std::size_t begin, std::size_t end, int) {
-          for (std::size_t i = begin; i < end; ++i) {
-            if (!bad(i)) continue;
-            std::size_t seen = first.load();
-            while (i < seen && !first.compare_exchange_weak(seen, i)) {
+          for (std::size_t block = begin; block < end; block += 256) {
+            const std::size_t last = std::min(block + 256, end);
+            if (blockIsGood(block, last)) continue;
+            for (std::size_t i = block; i < last; ++i) {
+              if (!bad(i)) continue;
+              std::size_t seen = first.load();
+              while (i < seen && !first.compare_exchange_weak(seen, i)) {
+              }
+              return;
             }
-            return;
           }
         },
         4096);
