@@ -136,8 +136,9 @@ TEST(Lines, OnlyATautLineTakesTheFullNewtonStep) {
 TEST(Lines, TheStiffSolveGivesTheSameBitsEightLinesAtATimeAsFour) {
   // Where the CPU has AVX the full Newton step solves eight lines side by side (lines_wide.cpp,
   // built for AVX), else four: every lane's arithmetic must be the same. A 13 x 13 sheet (groups of
-  // 8 + 5 lines against 4 + 4 + 4 + 1), jittered, every line taut with its own tension, two
-  // particles held, two sweeps.
+  // 8 + 5 lines against 4 + 4 + 4 + 1; the first eight columns lie side by side in memory and are
+  // gathered and scattered eight particles at a time), jittered, every line taut with its own
+  // tension, two particles held (in those columns), two sweeps.
   if (stiffSolveLanes() != 8) GTEST_SKIP() << "this CPU has no AVX: the solve takes four lines alone";
   const auto solved = [](std::size_t lanes) {
     World world(test::hangingSheet(13, 1, 1));

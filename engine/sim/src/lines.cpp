@@ -127,8 +127,11 @@ template <std::size_t W, std::size_t FixedG>
 void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const ParticleIndex*, W>& p,
                      const std::array<const Real*, W>& rest, const std::array<Real*, W>& lambda,
                      const std::array<const float*, W>& tension, const std::array<float*, W>& tensionSum, std::size_t n,
-                     Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows) {
+                     Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
   static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
+  // Eight lines whose particles at each k are consecutive (p[g][k] = p[0][k] + g) are gathered and
+  // scattered eight particles at a time (lines_wide.cpp): the same bits as below.
+  constexpr bool kWide = W == 8 && FixedG == 8;
   const std::size_t G = FixedG != 0 ? FixedG : count;
   using Row = SolverScratch::StiffRows;
   Vec3* x = s.position.data();
@@ -157,32 +160,39 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
     from[g] = x[p[g][0]];
     fromW[g] = w[p[g][0]];
   }
-  for (std::size_t k = 0; k < n; ++k) {
-    Row& r = rows[k];
-    for (std::size_t g = 0; g < G; ++g) {
-      r.mass[g] = static_cast<float>(mass[p[g][k]] * perUnitMass[g]);
-      r.moves[g] = fromW[g] > 0.0 ? 1.0f : 0.0f;
-      if (k == links) {
-        r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
-        continue;
+  const bool wide = kWide && consecutive;
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "the wide gather reads positions as x, y, z doubles");
+  if (wide) {
+    gatherConsecutiveWide(rows, n, reinterpret_cast<const double*>(x), w, mass, p[0], rest.data(), lambda.data(),
+                          tension.data(), perUnitMass.data(), alphaTilde);
+  } else {
+    for (std::size_t k = 0; k < n; ++k) {
+      Row& r = rows[k];
+      for (std::size_t g = 0; g < G; ++g) {
+        r.mass[g] = static_cast<float>(mass[p[g][k]] * perUnitMass[g]);
+        r.moves[g] = fromW[g] > 0.0 ? 1.0f : 0.0f;
+        if (k == links) {
+          r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
+          continue;
+        }
+        const Vec3 to = x[p[g][k + 1]];
+        const Real toW = w[p[g][k + 1]];
+        const Vec3 d = to - from[g];
+        r.nx[g] = static_cast<float>(d.x);
+        r.ny[g] = static_cast<float>(d.y);
+        r.nz[g] = static_cast<float>(d.z);
+        // C + alpha~ lambda = length - (rest - alpha~ lambda)
+        r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
+        // Pulled links only: a pushed one would make K indefinite.
+        r.g[g] = static_cast<float>(std::max(-static_cast<Real>(tension[g][k]), 0.0) * perUnitMass[g]);
+        r.live[g] = fromW[g] + toW + alphaTilde > 0.0 ? 1.0f : 0.0f;
+        from[g] = to;
+        fromW[g] = toW;
       }
-      const Vec3 to = x[p[g][k + 1]];
-      const Real toW = w[p[g][k + 1]];
-      const Vec3 d = to - from[g];
-      r.nx[g] = static_cast<float>(d.x);
-      r.ny[g] = static_cast<float>(d.y);
-      r.nz[g] = static_cast<float>(d.z);
-      // C + alpha~ lambda = length - (rest - alpha~ lambda)
-      r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
-      // Pulled links only: a pushed one would make K indefinite.
-      r.g[g] = static_cast<float>(std::max(-static_cast<Real>(tension[g][k]), 0.0) * perUnitMass[g]);
-      r.live[g] = fromW[g] + toW + alphaTilde > 0.0 ? 1.0f : 0.0f;
-      from[g] = to;
-      fromW[g] = toW;
-    }
-    for (std::size_t g = G; g < W; ++g) {
-      r.mass[g] = 1.0f;
-      r.moves[g] = r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
+      for (std::size_t g = G; g < W; ++g) {
+        r.mass[g] = 1.0f;
+        r.moves[g] = r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
+      }
     }
   }
   // A held particle or a dead link is masked, not branched on.
@@ -195,10 +205,11 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
   // (its move is 0 too, but it must stay put even if something upstream went non-finite).
   std::array<Real, W> multiplierScale{};
   for (std::size_t g = 0; g < G; ++g) multiplierScale[g] = unitMass[g] * stiffness;
+  if (wide) scatterConsecutiveWide(rows, n, reinterpret_cast<double*>(x), p[0], stiffness);
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
     for (std::size_t g = 0; g < G; ++g) {
-      if (r.moves[g] != 0.0f) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
+      if (!wide && r.moves[g] != 0.0f) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;
@@ -257,9 +268,9 @@ void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::
 }
 
 // The lines line[0, count) of a family, up to W at a time, as many equally long ones as follow
-// each other: solve(G, particles, rests, lambdas, offsets, n), each array holding W lines'
-// pointers of which the first G are filled (lambdas null without XPBD). A lane left empty costs
-// as much as a filled one, so a short group beats lines one by one.
+// each other: solve(G, particles, rests, lambdas, offsets, n, lines), each array holding W lines'
+// pointers of which the first G are filled (lambdas null without XPBD), and lines their indices.
+// A lane left empty costs as much as a filled one, so a short group beats lines one by one.
 template <std::size_t W, class Solve>
 void inLanes(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t count, bool xpbd, Solve&& solve) {
   const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
@@ -272,7 +283,7 @@ void inLanes(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::s
     std::size_t G = 1;
     while (G < W && i + G < count && length(i + G) == n) ++G;
     const LineData<W> d = lineData<W>(lines, line + i, G, xpbd);
-    solve(G, d.p, d.rest, d.lambda, d.offset, n);
+    solve(G, d.p, d.rest, d.lambda, d.offset, n, line + i);
     i += G;
   }
 }
@@ -347,6 +358,14 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
     }
     lines.start.push_back(static_cast<std::uint32_t>(lines.particle.size()));
     lines.lambda.clear();  // sized by the XPBD solve, which alone uses it
+    const std::size_t count = lines.start.size() - 1;
+    lines.besideNext.assign(count, 0);
+    for (std::size_t l = 0; l + 1 < count; ++l) {
+      const std::uint32_t a = lines.start[l], b = lines.start[l + 1], length = b - a;
+      bool beside = lines.start[l + 2] - b == length;
+      for (std::uint32_t k = 0; beside && k < length; ++k) beside = lines.particle[b + k] == lines.particle[a + k] + 1;
+      lines.besideNext[l] = beside ? 1 : 0;
+    }
   }
   scratch.stiffLanes = cpuHasAvx() ? 8 : 4;
   scratch.lineStride = longest * 4;  // four lines interleaved
@@ -424,23 +443,28 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
             const std::uint32_t* line = lines.order.data() + from + first;
             if (stiff) {
               const auto solveStiff = [&]<std::size_t W>(std::integral_constant<std::size_t, W>) {
-                inLanes<W>(
-                    lines, line, last - first, xpbd,
-                    [&](std::size_t G, const auto& p, const auto& rest, const auto& lambda, const auto& offset,
-                        std::size_t n) {
-                      std::array<const float*, W> tension{};
-                      std::array<float*, W> tensionSum{};
-                      for (std::size_t g = 0; g < G; ++g) {
-                        tension[g] = lines.tension.data() + offset[g];
-                        tensionSum[g] = lines.tensionSum.data() + offset[g];
-                      }
-                      StiffRow* rows = scratch.lineStiff.data() + slice / 4;
-                      if (G == W) {
-                        solveStiffLines<W, W>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha, rows);
-                      } else {
-                        solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha, rows);
-                      }
-                    });
+                inLanes<W>(lines, line, last - first, xpbd,
+                           [&](std::size_t G, const auto& p, const auto& rest, const auto& lambda, const auto& offset,
+                               std::size_t n, const std::uint32_t* ids) {
+                             std::array<const float*, W> tension{};
+                             std::array<float*, W> tensionSum{};
+                             for (std::size_t g = 0; g < G; ++g) {
+                               tension[g] = lines.tension.data() + offset[g];
+                               tensionSum[g] = lines.tensionSum.data() + offset[g];
+                             }
+                             StiffRow* rows = scratch.lineStiff.data() + slice / 4;
+                             if (G == W) {
+                               bool consecutive = true;
+                               for (std::size_t g = 0; consecutive && g + 1 < W; ++g) {
+                                 consecutive = ids[g + 1] == ids[g] + 1 && lines.besideNext[ids[g]];
+                               }
+                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                                     rows, consecutive);
+                             } else {
+                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
+                                                     rows, false);
+                             }
+                           });
               };
               if (scratch.stiffLanes == 8) {
                 solveStiff(std::integral_constant<std::size_t, 8>{});

@@ -1,8 +1,9 @@
-// The AVX build of the stiff line solve's elimination (lines_wide.cpp): call it only where the CPU
-// has AVX (lines.cpp checks once).
+// The AVX build of the stiff line solve's elimination, and of its gather and scatter for eight
+// neighbouring lines (lines_wide.cpp): call them only where the CPU has AVX (lines.cpp checks once).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "drape/sim/state.hpp"
 
@@ -10,5 +11,17 @@ namespace drape::sim::lines {
 
 // solveStiffLanes for all eight lanes of rows[0, n), alphaTilde one float per lane.
 void solveStiffLanesWide(SolverScratch::StiffRows* rows, std::size_t n, const float* alphaTilde);
+
+// solveStiffLines' gather (lines.cpp) for eight lines whose particles at k are first[k] to
+// first[k] + 7 (a lattice's neighbouring columns, say), position holding x, y, z per particle: the
+// same rows[0, n), bit for bit. rest, lambda (null entries without XPBD) and tension: each line's.
+void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const double* position,
+                           const double* inverseMass, const double* mass, const std::uint32_t* first,
+                           const double* const* rest, const double* const* lambda, const float* const* tension,
+                           const double* perUnitMass, double alphaTilde);
+// ... and its scatter of the moves (the multipliers are the caller's): each particle that moves by
+// yx * stiffness.
+void scatterConsecutiveWide(const SolverScratch::StiffRows* rows, std::size_t n, double* position,
+                            const std::uint32_t* first, double stiffness);
 
 }  // namespace drape::sim::lines

@@ -87,6 +87,9 @@ struct SolverScratch {
     // tension.
     std::vector<std::uint8_t> taut;
     std::vector<std::uint32_t> order;
+    // Per line: 1 if line l + 1 is as long and each of its particles is the one after l's (on a
+    // lattice, the column beside it): eight such lines are gathered eight particles at a time.
+    std::vector<std::uint8_t> besideNext;
     std::size_t tautCount = 0;
     bool ordered = false;
   };
