@@ -353,9 +353,9 @@ TEST(Workers, SharedBlocksVisitEveryItemOnceWhateverTheThreads) {
 }
 
 TEST(Workers, SharedBlocksGoFirstToTheThreadWhoseShareTheyAreIn) {
-  // Each thread's share is the blocks run would give it in one chunk. It takes its own from the
-  // front, in order, then the others' from their backs; thread 0 is made slow so that the others
-  // come to take some of its share.
+  // Each thread's share is its part of the blocks, split as evenly as run splits items. It takes its
+  // own from the front, in order, then the others' from their backs. Thread 0 is made slow so that
+  // the others are likely to take some of its share (not asserted: that depends on timing).
   constexpr std::size_t kN = 10007, kBlock = 100, kBlocks = (kN + kBlock - 1) / kBlock;
   for (int threads : {2, 3}) {
     Workers workers(threads);

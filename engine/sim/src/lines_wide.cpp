@@ -59,13 +59,8 @@ void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const 
     _mm256_storeu_ps(
         r.moves, toFloats(ones(_mm256_cmp_pd(wLow, zero, _CMP_GT_OQ)), ones(_mm256_cmp_pd(wHigh, zero, _CMP_GT_OQ))));
     if (k == links) {
-      const __m256 none = _mm256_setzero_ps();
-      _mm256_storeu_ps(r.nx, none);
-      _mm256_storeu_ps(r.ny, none);
-      _mm256_storeu_ps(r.nz, none);
-      _mm256_storeu_ps(r.rhs, none);
-      _mm256_storeu_ps(r.g, none);
-      _mm256_storeu_ps(r.live, none);
+      float* const none[] = {r.nx, r.ny, r.nz, r.rhs, r.g, r.live};  // no link after the last particle
+      for (float* lanes : none) _mm256_storeu_ps(lanes, _mm256_setzero_ps());
       continue;
     }
     if (k + 4 < n) {  // the rows ahead: particles a row apart are a lattice's width apart in memory

@@ -67,7 +67,8 @@ void Workers::part(Call call, void* task, std::size_t n, std::size_t block, int 
 }
 
 void Workers::dispatch(std::size_t n, std::size_t grain, std::size_t block, Call call, void* task) {
-  if (block != 0) block = std::max<std::size_t>(block, (n >> 32) + 1);  // a share counts blocks in 32 bits
+  // A share counts its blocks in 32 bits: at most 2^31 of them.
+  if (block != 0) block = std::max<std::size_t>(block, (n >> 31) + 1);
   std::size_t most = std::max<std::size_t>(n / std::max<std::size_t>(grain, 1), 1);
   if (block != 0) most = std::min(most, (n + block - 1) / block);  // no part without a block to take
   const int parts = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(threads()), most));

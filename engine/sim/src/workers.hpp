@@ -39,11 +39,11 @@ class Workers {
   // As run, but [0, n) is cut into blocks of `block` items, f called once a block, and the blocks
   // go to whichever thread is free: for loops whose items cost more in one part of the range than
   // in another (the tethers of particles near the pins), or whose threads run at different speeds
-  // (a core shared with another machine). Each thread has a share, the blocks run would give it in
-  // one chunk: it takes its own from the front, then helps the others from their backs. So a thread
-  // works on much the same particles loop after loop, and they stay in its core's cache (on hang2
-  // 256 with 2 threads, taking the blocks in turn from one shared counter made the steps about a
-  // fifth slower).
+  // (a core shared with another machine). Each thread has a share of the blocks, as even as run's
+  // chunks but in whole blocks: it takes its own from the front, then helps the others from their
+  // backs. So a thread works on much the same particles loop after loop, and they stay in its
+  // core's cache (on hang2 256 with 2 threads, taking the blocks in turn from one shared counter
+  // made the steps about a fifth slower).
   template <class F>
   void runShared(std::size_t n, std::size_t block, F&& f, std::size_t grain = 512) {
     dispatch(n, grain, std::max<std::size_t>(block, 1), caller<F>(), static_cast<void*>(&f));
