@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -14,9 +15,11 @@
 #include <glm/geometric.hpp>
 
 #include "batches.hpp"
+#include "distance_wide.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 #include "lines.hpp"
+#include "position_model.hpp"
 #include "workers.hpp"
 #include "world_builder.hpp"
 
@@ -291,6 +294,47 @@ TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
       EXPECT_EQ(again.constraints[kind][k].b, rest.constraints[kind][k].b);
     }
   }
+}
+
+TEST(Batches, FourAtATimeTheProjectionsGiveTheSameBitsAsOneByOne) {
+  // Where the CPU has AVX a batch's distance constraints are projected four at a time
+  // (distance_wide.cpp): the same bits as projectDistance one by one. A batch of 103 (25 groups of
+  // four and three left over), its particles jittered, among them pairs that are both held,
+  // coincident, at -0.0, or stretched a thousandfold, and one with a single held end.
+  if (!lines::cpuHasAvx()) GTEST_SKIP() << "this CPU has no AVX: batches are projected one by one";
+  std::mt19937 random(5);
+  std::uniform_real_distribution<Real> jitter(-0.02, 0.02);
+  std::vector<Vec3> start;
+  std::vector<Real> inverseMass;
+  std::vector<DistanceConstraint> batch;
+  for (ParticleIndex k = 0; k < 103; ++k) {
+    const Vec3 a{0.01 * k + jitter(random), jitter(random), jitter(random)};
+    Vec3 b = a + Vec3{0.01 + jitter(random), jitter(random), jitter(random)};
+    Real wa = 1.0 + jitter(random), wb = 2.0 + jitter(random);
+    if (k == 6) wa = wb = 0.0;                    // nothing to move
+    if (k == 9) b = a;                            // coincident: no direction
+    if (k == 13) wb = 0.0;                        // one end held
+    if (k == 17) b = a + Vec3{10.0, -0.0, -0.0};  // stretched a thousandfold
+    start.push_back(a);
+    start.push_back(k == 21 ? Vec3{-0.0, -0.0, -0.0} : b);
+    inverseMass.push_back(wa);
+    inverseMass.push_back(wb);
+    batch.push_back({2 * k, 2 * k + 1, 0.01});
+  }
+  const Real stiffness = 0.9;
+  std::vector<Vec3> one = start;
+  for (const DistanceConstraint& c : batch) position::projectDistance(one, inverseMass, c, stiffness);
+  std::vector<Vec3> four = start;
+  const std::size_t done = position::projectBatchWide(reinterpret_cast<double*>(four.data()), inverseMass.data(),
+                                                      batch.data(), 0, batch.size(), stiffness);
+  EXPECT_EQ(done, 100u);
+  for (std::size_t k = done; k < batch.size(); ++k) position::projectDistance(four, inverseMass, batch[k], stiffness);
+  for (std::size_t i = 0; i < start.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      ASSERT_EQ(std::memcmp(&four[i][axis], &one[i][axis], sizeof(Real)), 0) << "particle " << i << ", axis " << axis;
+    }
+  }
+  EXPECT_NE(one, start);  // the comparison is not of two untouched copies
 }
 
 TEST(Batches, AParticleWithMoreThan63ConstraintsGoesToASequentialTail) {

@@ -98,17 +98,6 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
 // (stiff_lanes.hpp): eight to an AVX register where the CPU has AVX, else four to an SSE one. It
 // only has to find the direction the second, double-precision step refines (the links' lengths it
 // leaves are that step's to correct).
-bool cpuHasAvx() {
-#if (defined(__x86_64__) || defined(__i386__)) && defined(DRAPE_WIDE_LANES)
-  static const bool has = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx") != 0;  // and the system saves its registers
-  }();
-  return has;
-#else
-  return false;
-#endif
-}
 
 // One full Newton step of G lines' projections from where their particles are now, geometric
 // stiffness included: with dx the particles' moves and l the links' multipliers,
@@ -302,6 +291,18 @@ bool needsFullStep(const SolverScratch::LineFamily& lines, std::size_t l, const 
 }
 
 }  // namespace
+
+bool cpuHasAvx() {
+#if (defined(__x86_64__) || defined(__i386__)) && defined(DRAPE_WIDE_LANES)
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx") != 0;  // and the system saves its registers
+  }();
+  return has;
+#else
+  return false;
+#endif
+}
 
 void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
   const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);

@@ -16,6 +16,11 @@
 
 namespace drape::sim::lines {
 
+// Whether this CPU has AVX (and the system saves its registers), asked once: the files built for
+// AVX (lines_wide.cpp, distance_wide.cpp) are called only where it has. False where the engine is
+// not built with them.
+bool cpuHasAvx();
+
 // Rebuilds scratch.lines and scratch.looseStretch from the cloth's stretch constraints. A link
 // goes to the family of its rest direction (along x, or not) and joins a line there unless that
 // would give a particle three links in the family or close a loop; then it is loose.

@@ -2,6 +2,7 @@
 
 #include "aerodynamics.hpp"
 #include "contacts.hpp"
+#include "distance_wide.hpp"
 #include "lines.hpp"
 
 #include <algorithm>
@@ -222,8 +223,7 @@ void projectTethers(ParticleState& s, const SolverScratch::Tethers& tethers, std
   }
 }
 
-// Constraints [begin, end) of one kind, in order, as projectDistance each. (Taking a batch four at a
-// time into lanes for vector instructions was measured on hang2: no faster, so not kept.)
+// Constraints [begin, end) of one kind, in order, as projectDistance each.
 void projectRange(ParticleState& s, const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
                   Real stiffness) {
   for (std::size_t k = begin; k < end; ++k) projectDistance(s.position, s.inverseMass, constraints[k], stiffness);
@@ -294,24 +294,30 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     }
     const DistanceConstraint* constraints = cloth.rest.of(kind).data();
     Real* lambda = scratch.lambda[kindIndex].data();
-    const auto body = [&](std::size_t begin, std::size_t end) {
+    // A batch's constraints (no two share a particle) four at a time where the CPU has AVX.
+    const auto body = [&](std::size_t begin, std::size_t end, bool batch) {
       if (solver.xpbd) {
         projectCompliantRange(s, constraints, lambda, begin, end, alphaTilde);
-      } else {
-        projectRange(s, constraints, begin, end, material.stiffness);
+        return;
       }
+      if (batch && lines::cpuHasAvx()) {
+        static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are read as x, y, z doubles");
+        begin = projectBatchWide(reinterpret_cast<double*>(s.position.data()), s.inverseMass.data(), constraints, begin,
+                                 end, material.stiffness);
+      }
+      projectRange(s, constraints, begin, end, material.stiffness);
     };
     const std::vector<std::uint32_t>& start = scratch.batchStart[kindIndex];
     for (std::size_t b = 0; b + 1 < start.size(); ++b) {
       const std::size_t begin = start[b], end = start[b + 1];
       if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
-        body(begin, end);  // its constraints may share particles: one thread, one after another
+        body(begin, end, false);  // its constraints may share particles: one thread, one after another
       } else {
         // Blocks of up to 2048 constraints, at least four a thread (hang2 64's batches hold 2000).
         const std::size_t block =
             std::clamp<std::size_t>((end - begin) / (4 * static_cast<std::size_t>(workers.threads())), 256, 2048);
         workers.runShared(end - begin, block,
-                          [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last); });
+                          [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last, true); });
       }
     }
   }
