@@ -95,10 +95,10 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
 }
 
 // The full Newton step runs in single precision, lines side by side in vector lanes
-// (stiff_lanes.hpp): eight to an AVX register where the CPU has AVX, else four to an SSE one. It
-// only has to find the direction the second, double-precision step refines (the links' lengths it
-// leaves are that step's to correct).
-
+// (stiff_lanes.hpp): eight to an AVX register where the CPU has AVX (cpuHasAvx), else four to an SSE
+// one. It only has to find the direction the second, double-precision step refines (the links'
+// lengths it leaves are that step's to correct).
+//
 // One full Newton step of G lines' projections from where their particles are now, geometric
 // stiffness included: with dx the particles' moves and l the links' multipliers,
 //   K dx - J^T l = 0,   J dx + alpha~ l = -(C + alpha~ lambda),
@@ -143,18 +143,18 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
   // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
   // the link's direction, value and geometric stiffness (normalise). Each line's particle at k + 1
   // is carried over as the next link's first. Lanes no line fills hold a held particle and no link.
-  std::array<Vec3, W> from;
-  std::array<Real, W> fromW;
-  for (std::size_t g = 0; g < G; ++g) {
-    from[g] = x[p[g][0]];
-    fromW[g] = w[p[g][0]];
-  }
   const bool wide = kWide && consecutive;
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "the wide gather reads positions as x, y, z doubles");
   if (wide) {
     gatherConsecutiveWide(rows, n, reinterpret_cast<const double*>(x), w, mass, p[0], rest.data(), lambda.data(),
                           tension.data(), perUnitMass.data(), alphaTilde);
   } else {
+    std::array<Vec3, W> from;
+    std::array<Real, W> fromW;
+    for (std::size_t g = 0; g < G; ++g) {
+      from[g] = x[p[g][0]];
+      fromW[g] = w[p[g][0]];
+    }
     for (std::size_t k = 0; k < n; ++k) {
       Row& r = rows[k];
       for (std::size_t g = 0; g < G; ++g) {
