@@ -269,6 +269,12 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       if (tuned.solver.lines && tuned.solver.tethers) {
         changed |= ImGui::Checkbox("tethers between line steps", &tuned.solver.tethersBetweenSteps);
       }
+      if (tuned.solver.lines) {
+        changed |= ImGui::SliderInt("extra line steps", &tuned.solver.extraLineSteps, 0, 8);
+        if (tuned.solver.extraLineSteps > 0) {
+          changed |= sliderReal("while stretched over", tuned.solver.stretchTolerance, 0.0, 0.2, "%.3f");
+        }
+      }
     }
     int threads = session.threads();
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

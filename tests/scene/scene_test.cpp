@@ -337,5 +337,28 @@ TEST(SceneReader, TethersBetweenStepsNeedLinesAndTethers) {
   }
 }
 
+TEST(SceneReader, ExtraLineStepsNeedLinesAndAToleranceInRange) {
+  json document = minimal();
+  applyOverride(document, "solver.lines=true");
+  applyOverride(document, "solver.extraLineSteps=3");
+  applyOverride(document, "solver.stretchTolerance=0.02");
+  const sim::SolverSettings solver = parseScene(document, "s.json").world.solver;
+  EXPECT_EQ(solver.extraLineSteps, 3);
+  EXPECT_DOUBLE_EQ(solver.stretchTolerance, 0.02);
+  EXPECT_EQ(parseScene(minimal(), "s.json").world.solver.extraLineSteps, 0);
+  json without = document;
+  applyOverride(without, "solver.lines=false");
+  EXPECT_EQ(errorOf([&] { parseScene(without, "s.json"); }),
+            "s.json: solver.extraLineSteps: expected 0 unless \"lines\" is true (it adds steps to the line solve), "
+            "got 3");
+  json negative = document;
+  applyOverride(negative, "solver.stretchTolerance=-0.1");
+  EXPECT_NE(errorOf([&] { parseScene(negative, "s.json"); }).find("s.json: solver.stretchTolerance: "),
+            std::string::npos);
+  json many = document;
+  applyOverride(many, "solver.extraLineSteps=101");
+  EXPECT_NE(errorOf([&] { parseScene(many, "s.json"); }).find("s.json: solver.extraLineSteps: "), std::string::npos);
+}
+
 }  // namespace
 }  // namespace drape::scene

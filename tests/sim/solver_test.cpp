@@ -655,6 +655,83 @@ TEST(FastSweep, TethersBetweenTheLineStepsHoldAFinerSheetInOneSubstep) {
   EXPECT_GT(worst(false), 0.3);
 }
 
+TEST(FastSweep, WithTheTethersBetweenTheLineStepsASweepEndsWithEveryParticleWithinItsTethers) {
+  // hang2 at 64 x 64 in one substep: the tethers come after the last line step too, so after every
+  // frame no particle is farther from either pin than at rest. Before they did, the last step's
+  // columns pulled the top row's particles beside the pins down and away from them.
+  WorldSettings settings = fastSheet(64, 1);
+  settings.solver.geometricStiffness = true;
+  settings.solver.tethersBetweenSteps = true;
+  World world(settings);
+  const std::vector<Vec3>& rest = world.cloths()[0].rest.restPositions;
+  const std::array<ParticleIndex, 2> pins{0, 63};
+  Real worst = 0.0;  // the most a particle is beyond a tether, relative to its length
+  for (int frame = 0; frame < 60; ++frame) {
+    world.step();
+    const std::vector<Vec3>& x = world.cloths()[0].state.position;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      for (const ParticleIndex pin : pins) {
+        if (i == pin) continue;
+        worst = std::max(worst, glm::length(x[i] - x[pin]) / glm::length(rest[i] - rest[pin]) - 1.0);
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(structuralStrain(world).max, 1e-3);  // the cloth is stretched; the tethers hold it
+}
+
+TEST(FastSweep, ExtraLineStepsLeaveEveryEdgeWithinTheToleranceUnlessTheyRunOut) {
+  // hang2 at 64 x 64 in one substep of one sweep, allowed up to 3 more line steps a sweep while an
+  // edge is more than 0.5 % long. Every frame whose sweep stopped before the third ends with every
+  // edge within 0.5 %; the steps are taken (in some frames all three), and the worst edge is
+  // shorter than with none.
+  const auto settings = [](int extra) {
+    WorldSettings world = fastSheet(64, 1);
+    world.solver.geometricStiffness = true;
+    world.solver.tethersBetweenSteps = true;
+    world.solver.extraLineSteps = extra;
+    world.solver.stretchTolerance = 0.005;
+    return world;
+  };
+  World plain(settings(0)), extra(settings(3));
+  Real plainWorst = 0.0, extraWorst = 0.0;
+  int ranOut = 0;
+  for (int frame = 0; frame < 60; ++frame) {
+    const std::int64_t before = extra.extraLineSteps();
+    plain.step();
+    extra.step();
+    const std::int64_t taken = extra.extraLineSteps() - before;
+    ASSERT_LE(taken, 3);
+    const Real strain = structuralStrain(extra).max;
+    if (taken < 3) {
+      EXPECT_LE(strain, 0.005 + 1e-12) << "frame " << frame;
+    } else {
+      ++ranOut;
+    }
+    plainWorst = std::max(plainWorst, structuralStrain(plain).max);
+    extraWorst = std::max(extraWorst, strain);
+  }
+  EXPECT_EQ(plain.extraLineSteps(), 0);
+  EXPECT_GT(extra.extraLineSteps(), 0);
+  EXPECT_GT(ranOut, 0);
+  EXPECT_LT(extraWorst, 0.8 * plainWorst);
+}
+
+TEST(FastSweep, ExtraLineStepsCostNothingWhileTheClothIsWithinTheTolerance) {
+  // With a tolerance no edge reaches, the sweep only checks: the same result, bit for bit, as
+  // without extra steps.
+  WorldSettings settings = fastSheet(32, 1);
+  settings.solver.geometricStiffness = true;
+  settings.solver.tethersBetweenSteps = true;
+  const std::vector<Vec3> none = test::positionsAfter(settings, 1, 30);
+  settings.solver.extraLineSteps = 4;
+  settings.solver.stretchTolerance = 1.0;
+  World world(settings);
+  world.run(30);
+  EXPECT_EQ(world.extraLineSteps(), 0);
+  EXPECT_EQ(world.cloths()[0].state.position, none);
+}
+
 TEST(FastSweep, ThreadsStayBitIdenticalThroughTearingAndXpbd) {
   for (const bool geometricStiffness : {false, true}) {
     WorldSettings settings = fastSheet(32, 2);
@@ -948,13 +1025,19 @@ TEST(FastSweep, ThreadsSplittingTautAndSlackLinesStayBitIdentical) {
   // 151 lines a family, cut among 2 and 3 threads into different groups, taut lines (the full step)
   // and slack ones (the tridiagonal) each: with geometric stiffness, and with the tethers between
   // the line steps too. Ten frames, long enough for tension to build and the lines to part.
-  for (const bool between : {false, true}) {
+  // With extra line steps where an edge is over 0.1 % (which every frame has), the check too.
+  for (const auto& [between, extra] : {std::pair{false, 0}, {true, 0}, {true, 2}}) {
     WorldSettings settings = fastSheet(151, 2);
     settings.solver.geometricStiffness = true;
     settings.solver.tethersBetweenSteps = between;
+    settings.solver.extraLineSteps = extra;
+    settings.solver.stretchTolerance = 0.001;
+    World probe(settings);
+    probe.run(10);
+    EXPECT_EQ(probe.extraLineSteps() > 0, extra > 0);
     const std::vector<Vec3> one = test::positionsAfter(settings, 1, 10);
-    EXPECT_EQ(test::positionsAfter(settings, 2, 10), one) << "tethers between steps " << between;
-    EXPECT_EQ(test::positionsAfter(settings, 3, 10), one) << "tethers between steps " << between;
+    EXPECT_EQ(test::positionsAfter(settings, 2, 10), one) << "tethers between steps " << between << ", extra " << extra;
+    EXPECT_EQ(test::positionsAfter(settings, 3, 10), one) << "tethers between steps " << between << ", extra " << extra;
   }
 }
 

@@ -205,12 +205,19 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.lines = solver.boolean("lines", false);
     world.solver.geometricStiffness = solver.boolean("geometricStiffness", false);
     world.solver.tethersBetweenSteps = solver.boolean("tethersBetweenSteps", false);
+    world.solver.extraLineSteps = solver.integer("extraLineSteps", 0, 0, sim::kMaxExtraLineSteps);
+    world.solver.stretchTolerance =
+        solver.number("stretchTolerance", world.solver.stretchTolerance, {0.0, 10.0, false, ""});
     if (world.solver.model != Model::position) {
       for (const char* key : {"xpbd", "tethers", "lines", "geometricStiffness", "tethersBetweenSteps"}) {
         if (solver.has(key) && solver.boolean(key, false)) {
           solver.fail(key, "false for the force model (it belongs to the position model)", solver.raw(key));
         }
       }
+    }
+    if (world.solver.extraLineSteps > 0 && !world.solver.lines) {
+      solver.fail("extraLineSteps", "0 unless \"lines\" is true (it adds steps to the line solve)",
+                  solver.raw("extraLineSteps"));
     }
     if (world.solver.geometricStiffness && !world.solver.lines) {
       solver.fail("geometricStiffness", "false unless \"lines\" is true (it is part of the line solve)",
@@ -307,8 +314,10 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
     for (sim::ClothSettings& cloth : changed.world.cloths) {
       for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(model, kind);
     }
-    if (model == Model::force)
+    if (model == Model::force) {
       solver.xpbd = solver.tethers = solver.lines = solver.geometricStiffness = solver.tethersBetweenSteps = false;
+      solver.extraLineSteps = 0;
+    }
   }
   solver.model = model;
   solver.integrator = integrator;
@@ -324,6 +333,7 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
       solverDocument.erase("lines");
       solverDocument.erase("geometricStiffness");
       solverDocument.erase("tethersBetweenSteps");
+      solverDocument.erase("extraLineSteps");
     }
     if (document.contains("cloths") && document["cloths"].is_array()) {
       for (json& cloth : document["cloths"]) {

@@ -6,6 +6,7 @@
 #include "lines.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -235,6 +236,30 @@ void projectCompliantRange(ParticleState& s, const DistanceConstraint* constrain
     projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
 }
 
+// Whether some stretch constraint is longer than (1 + tolerance) times its rest length. Any
+// thread that finds one stops the others looking; the answer is the same whoever finds it.
+bool stretchedBeyond(const Cloth& cloth, Real tolerance, Workers& workers) {
+  const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
+  const Vec3* x = cloth.state.position.data();
+  const Real scale = (1.0 + tolerance) * (1.0 + tolerance);
+  std::atomic<bool> found{false};
+  workers.run(
+      stretch.size(),
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t block = begin; block < end && !found.load(std::memory_order_relaxed); block += 1024) {
+          bool beyond = false;
+          for (std::size_t k = block, last = std::min(block + 1024, end); k < last; ++k) {
+            const DistanceConstraint& c = stretch[k];
+            const Vec3 d = x[c.b] - x[c.a];
+            beyond |= glm::dot(d, d) > scale * (c.restLength * c.restLength);
+          }
+          if (beyond) found.store(true, std::memory_order_relaxed);
+        }
+      },
+      4096);
+  return found.load();
+}
+
 }  // namespace
 
 namespace {
@@ -280,16 +305,21 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     if (kind == ConstraintKind::stretch) {
       const Real stiffness = solver.xpbd ? 1.0 : material.stiffness;
       Real* looseLambda = scratch.lambda[kindIndex].data();
-      if (solver.tethersBetweenSteps) {
-        const bool gs = solver.geometricStiffness;
-        lines::step(cloth, scratch, stiffness, solver.xpbd, alphaTilde, gs, true, workers);
-        tethers();
-        lines::step(cloth, scratch, stiffness, solver.xpbd, alphaTilde, gs, true, workers);
-        lines::solveLoose(cloth, scratch, stiffness, solver.xpbd, alphaTilde, looseLambda);
-      } else {
-        lines::solve(cloth, scratch, stiffness, solver.xpbd, alphaTilde, solver.geometricStiffness, workers,
-                     looseLambda);
+      const bool gs = solver.geometricStiffness, between = solver.tethersBetweenSteps;
+      const auto step = [&](bool full) {
+        lines::step(cloth, scratch, stiffness, solver.xpbd, alphaTilde, gs, full, workers);
+        if (between) tethers();
+      };
+      // Two Newton steps (lines::solve); with the tethers between, both full and the tethers after
+      // each: the tethers keep the edges beside a pin from being pulled long by the last step.
+      step(true);
+      step(between);
+      for (int extra = 0; extra < solver.extraLineSteps && stretchedBeyond(cloth, solver.stretchTolerance, workers);
+           ++extra) {
+        step(true);
+        ++scratch.extraLineSteps;
       }
+      lines::solveLoose(cloth, scratch, stiffness, solver.xpbd, alphaTilde, looseLambda);
       continue;
     }
     const DistanceConstraint* constraints = cloth.rest.of(kind).data();

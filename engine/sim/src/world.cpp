@@ -79,6 +79,10 @@ void validate(const WorldSettings& s) {
   require(solver.dt / solver.substeps >= 1e-9, "the substep dt / substeps must be at least 1e-9 s");
   require(solver.iterations >= 0 && solver.iterations <= kMaxIterations, "solver.iterations is out of range");
   require(finite(solver.damping) && solver.damping >= 0.0, "solver.damping must be finite and >= 0");
+  require(solver.extraLineSteps >= 0 && solver.extraLineSteps <= kMaxExtraLineSteps,
+          "solver.extraLineSteps is out of range");
+  require(finite(solver.stretchTolerance) && solver.stretchTolerance >= 0.0,
+          "solver.stretchTolerance must be finite and >= 0");
   require(finite(s.gravity), "gravity must be finite");
   require(finite(s.air.velocity), "wind velocity must be finite");
   require(finite(s.air.drag) && s.air.drag >= 0.0, "wind drag must be finite and >= 0");
@@ -369,6 +373,12 @@ std::size_t World::memoryBytes() const { return memoryUse().total(); }
 std::size_t World::tetherCount() const {
   std::size_t n = 0;
   for (const SolverScratch& s : scratch_) n += s.tethers.size();
+  return n;
+}
+
+std::int64_t World::extraLineSteps() const {
+  std::int64_t n = 0;
+  for (const SolverScratch& s : scratch_) n += s.extraLineSteps;
   return n;
 }
 

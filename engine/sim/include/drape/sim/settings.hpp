@@ -58,11 +58,18 @@ struct SolverSettings {
   // stepped explicitly, and grow unless the substep is shorter than a wave takes to cross a link;
   // with it the substeps a stiff cloth needs no longer grow with its resolution.
   bool geometricStiffness = false;
-  // Position model, with lines and tethers: the tethers are projected again between the line
+  // Position model, with lines and tethers: the tethers are projected again after each of the line
   // solve's two Newton steps, and with geometric stiffness both steps are full. A tether's pull and
   // the lines' lengths then settle together within a sweep instead of across substeps: a fine
-  // stiff cloth hanging from pins needs half the substeps, each about a fifth dearer.
+  // stiff cloth hanging from pins needs half the substeps or fewer, each about a third dearer.
   bool tethersBetweenSteps = false;
+  // Position model, with lines: after a sweep's line steps, while some stretch constraint is longer
+  // than (1 + stretchTolerance) times its rest length, one more Newton step of every line (full
+  // with geometric stiffness, and the tethers after it with tethersBetweenSteps), at most
+  // extraLineSteps times a sweep. A frame that jerks the cloth (the first fall, a finger's yank)
+  // pays for the steps it needs; the others pay one pass that checks. 0: never.
+  int extraLineSteps = 0;
+  Real stretchTolerance = 0.04;
 };
 
 // The air around the cloth, moving uniformly at `velocity`.
@@ -144,6 +151,7 @@ inline constexpr int kMaxLatticeSide = 4096;
 inline constexpr long long kMaxParticles = 1 << 20;  // over all cloths of a world
 inline constexpr int kMaxSubsteps = 1000;
 inline constexpr int kMaxIterations = 10000;
+inline constexpr int kMaxExtraLineSteps = 100;
 // A particle farther than this from the origin is a runaway: the guard treats it like NaN.
 inline constexpr Real kRunawayDistance = 1.0e6;  // m
 inline constexpr Real kRunawaySpeed = 1.0e6;     // m/s, likewise for a stored velocity

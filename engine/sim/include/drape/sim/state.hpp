@@ -130,7 +130,8 @@ struct SolverScratch {
   // [batchStart[b], batchStart[b + 1]); with sequentialTail the last batch is not one.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;
   std::array<bool, kConstraintKindCount> sequentialTail{};
-  std::uint64_t planVersion = 0;  // the world's topology version the batches and lines were made for
+  std::uint64_t planVersion = 0;    // the world's topology version the batches and lines were made for
+  std::int64_t extraLineSteps = 0;  // line steps taken beyond a sweep's two (solver.extraLineSteps)
 };
 
 // The self-collision spatial hash over every particle of a world.
