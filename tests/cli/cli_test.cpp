@@ -404,7 +404,8 @@ TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
   std::getline(csv, line);
   EXPECT_EQ(line,
             "scene,n,particles,solver,threads,substeps,iterations,ms_per_frame,ms_per_frame_min,projections_per_s,"
-            "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle,tethers_between_steps");
+            "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle,tethers_between_steps,"
+            "extra_line_steps_per_frame");
   int drape = 0, naive = 0, tear = 0;
   double drapeStrain = 1.0, naiveStrain = 0.0;
   while (std::getline(csv, line)) {
@@ -441,6 +442,7 @@ TEST_F(Cli, BenchRefusesBadValuesWithOneLine) {
                      "no-such-scene");
   expectOneLineError(run("bench --sizes 1"), 2, "--sizes");
   expectOneLineError(run("bench --threads 0"), 2, "--threads");
+  expectOneLineError(run("bench --extra-line-steps 101"), 2, "--extra-line-steps");
   EXPECT_FALSE(fs::exists(file("p")));
 }
 

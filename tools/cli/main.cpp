@@ -138,6 +138,11 @@ int main(int argc, char** argv) {
       ->add_flag("--tethers-between-steps", benchArguments.tethersBetweenSteps,
                  "With --substeps: project the tethers again between the line solve's steps (tethersBetweenSteps)")
       ->needs("--substeps");
+  benchCommand
+      ->add_option("--extra-line-steps", benchArguments.extraLineSteps,
+                   "Drape's hang2 sweep: up to this many more line steps where an edge is still over 4 % "
+                   "(extraLineSteps; default 2)")
+      ->check(CLI::Range(0, 100));
   benchCommand->add_flag("--quick", benchArguments.quick,
                          "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps (each unless given)");
   addReportOptions(benchCommand, benchArguments.outDir, benchArguments.report, benchArguments.quiet);

@@ -12,6 +12,8 @@ sim::WorldSettings hang2(int n, const Hang2Solver& solver) {
   world.solver.tethers = solver.tethers;
   world.solver.geometricStiffness = solver.geometricStiffness;
   world.solver.tethersBetweenSteps = solver.tethersBetweenSteps;
+  world.solver.extraLineSteps = solver.extraLineSteps;
+  world.solver.stretchTolerance = solver.stretchTolerance;
   world.gravity = {0.0, -9.81, 0.0};
   sim::ClothSettings cloth;
   cloth.lattice = {n, n, 1.0, 1.0, sim::Vec3{0.0, 1.5, 0.0}, sim::LatticePlane::xz};

@@ -52,6 +52,7 @@ Measurement measureWorld(const sim::WorldSettings& settings, int frames, int thr
     const sim::StrainStats end = sim::structuralStrain(world);
     m.strainMaxEnd = end.max;
     m.strainMeanEnd = end.mean;
+    m.extraLineSteps = static_cast<double>(world.extraLineSteps()) / frames;
     const sim::MemoryUse use = world.memoryUse();
     m.bytes = use.total();
     m.bytesBy = {{"state", use.state},

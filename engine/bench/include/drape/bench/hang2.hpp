@@ -10,7 +10,8 @@ namespace drape::bench {
 // How Drape solves it (the configuration the benchmark reports): tethers to the two pins, each
 // row and column of stretch constraints solved at once with the links' geometric stiffness,
 // `substeps` substeps of one sweep each; with tethersBetweenSteps the tethers are projected again
-// between the line solve's two Newton steps.
+// after each of the line solve's two Newton steps. Up to extraLineSteps more steps a sweep where an
+// edge is still over stretchTolerance.
 struct Hang2Solver {
   int substeps = 2;
   int iterations = 1;
@@ -18,6 +19,8 @@ struct Hang2Solver {
   bool tethers = true;
   bool geometricStiffness = true;
   bool tethersBetweenSteps = false;
+  int extraLineSteps = 2;
+  double stretchTolerance = 0.04;
 };
 
 sim::WorldSettings hang2(int n, const Hang2Solver& solver = {});
