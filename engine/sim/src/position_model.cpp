@@ -7,9 +7,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 
 #include <glm/geometric.hpp>
+
+#if defined(__SSE2__) && defined(__x86_64__)
+#include <emmintrin.h>
+#endif
 
 namespace drape::sim::position {
 
@@ -41,8 +46,31 @@ void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, 
       [&](ParticleIndex p) { return (s.position[p] - s.previousPosition[p]) * inverseH; }, acceleration);
 }
 
+namespace {
+
+// The guard's copy is written once a step and read only if the step goes bad: stored past the
+// caches where the CPU can (SSE2's streaming stores), it neither reads the lines it fills nor
+// pushes the cloth out of the cache. keptAll makes the stores seen before the workers join.
+void keep(Vec3* to, const Vec3& x) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  static_assert(sizeof(Vec3) == 3 * sizeof(double));
+  long long* out = reinterpret_cast<long long*>(to);
+  for (int k = 0; k < 3; ++k) _mm_stream_si64(out + k, std::bit_cast<long long>(x[k]));
+#else
+  *to = x;
+#endif
+}
+
+void keptAll() {
+#if defined(__SSE2__) && defined(__x86_64__)
+  _mm_sfence();
+#endif
+}
+
+}  // namespace
+
 void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
-               Workers& workers) {
+               Workers& workers, Vec3* keepPosition, Vec3* keepPrevious) {
   ParticleState& s = cloth.state;
   // Exact for du/dt = a - k u over one substep: u' = u e^{-kh} + a h (1 - e^{-kh}) / (k h).
   const Real kh = (world.solver.damping + world.air.drag) * h;
@@ -54,6 +82,10 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
       s.position.size(),
       [&](std::size_t begin, std::size_t end, int) {
         for (std::size_t i = begin; i < end; ++i) {
+          if (keepPosition) {
+            keep(keepPosition + i, s.position[i]);
+            keep(keepPrevious + i, s.previousPosition[i]);
+          }
           if (s.inverseMass[i] == 0.0) {
             // Pinned or held: no force moves it, only the world does. It carries on as it was set to move
             // (a finger sets x_prev one finger step behind); a pin has x_prev = x and stays exactly put.
@@ -68,6 +100,7 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
           s.position[i] = x + (x - s.previousPosition[i]) * decay + acceleration * h2;
           s.previousPosition[i] = x;
         }
+        if (keepPosition) keptAll();
       },
       4096);
 }

@@ -432,10 +432,13 @@ void World::runStage(Stage stage) {
     SolverScratch& scratch = scratch_[c];
     switch (stage) {
       case Stage::windPressure: position::accumulateWindPressure(cloth, settings_.air, h, scratch.acceleration); break;
-      case Stage::verletIntegrate:
+      case Stage::verletIntegrate: {
+        Snapshot* keep = keepInIntegrate_ && substep_ == 0 ? &lastGood_[c] : nullptr;
         position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration,
-                            *workers_);
+                            *workers_, keep ? keep->position.data() : nullptr,
+                            keep ? keep->previousPosition.data() : nullptr);
         break;
+      }
       case Stage::projectConstraints:
         plan(c);
         position::projectConstraints(cloth, settings_.solver, h, scratch, !colliders_.empty(), *workers_);
@@ -521,7 +524,10 @@ StepStatus World::step() {
   using Clock = std::chrono::steady_clock;
   if (divergence_) return StepStatus::diverged;
   if (!historyStarted_) startHistory();
-  // Only what a step changes is kept (inverse masses do not change within a step).
+  // Only what a step changes is kept (inverse masses do not change within a step). Where the
+  // position model's integration is the first stage to change anything (no finger moves particles
+  // before it), it copies them as it reads them, in the same pass.
+  keepInIntegrate_ = settings_.solver.model == Model::position && !hasStage(Stage::fingers);
   lastGood_.resize(cloths_.size());
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     const ParticleState& s = cloths_[c].state;
@@ -529,6 +535,7 @@ StepStatus World::step() {
     good.position.resize(s.position.size());
     good.previousPosition.resize(s.previousPosition.size());
     good.velocity.resize(s.velocity.size());
+    if (keepInIntegrate_ && s.velocity.empty()) continue;
     workers_->run(
         s.position.size(),
         [&](std::size_t begin, std::size_t end, int) {

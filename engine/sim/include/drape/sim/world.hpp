@@ -195,6 +195,7 @@ class World {
     std::vector<Vec3> position, previousPosition, velocity;
   };
   std::vector<Snapshot> lastGood_;  // what the current step changes, as it was before it
+  bool keepInIntegrate_ = false;    // this step's integration makes lastGood_ (World::step)
   std::vector<Finger> fingers_;
   std::vector<std::vector<std::uint8_t>> held_;  // per cloth and particle: 1 while a finger holds it
   std::unique_ptr<Workers> workers_;
