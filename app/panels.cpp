@@ -270,9 +270,9 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
         changed |= ImGui::Checkbox("tethers between line steps", &tuned.solver.tethersBetweenSteps);
       }
       if (tuned.solver.lines) {
-        changed |= ImGui::SliderInt("extra line steps", &tuned.solver.extraLineSteps, 0, 8);
+        changed |= ImGui::SliderInt("extra steps", &tuned.solver.extraLineSteps, 0, 8);
         if (tuned.solver.extraLineSteps > 0) {
-          changed |= sliderReal("while stretched over", tuned.solver.stretchTolerance, 0.0, 0.2, "%.3f");
+          changed |= sliderReal("max stretch", tuned.solver.stretchTolerance, 0.0, 0.2, "%.3f");
         }
       }
     }
