@@ -421,6 +421,10 @@ TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
     if (std::string(solver) == "drape") {
       ++drape;
       drapeStrain = strainEnd;
+      // The last column: extra line steps per frame, at most the 2 a sweep may take.
+      const double extra = std::stod(line.substr(line.rfind(',') + 1));
+      EXPECT_GE(extra, 0.0) << line;
+      EXPECT_LE(extra, 2.0) << line;
     } else {
       ++naive;
       naiveStrain = strainEnd;

@@ -358,6 +358,18 @@ TEST(SceneReader, ExtraLineStepsNeedLinesAndAToleranceInRange) {
   json many = document;
   applyOverride(many, "solver.extraLineSteps=101");
   EXPECT_NE(errorOf([&] { parseScene(many, "s.json"); }).find("s.json: solver.extraLineSteps: "), std::string::npos);
+  json loose = document;
+  applyOverride(loose, "solver.stretchTolerance=11");
+  EXPECT_NE(errorOf([&] { parseScene(loose, "s.json"); }).find("s.json: solver.stretchTolerance: "), std::string::npos);
+  // The force model has no lines: the key is refused there, and dropped when a scene switches to it.
+  json force = minimal();
+  applyOverride(force, "solver.model=force");
+  applyOverride(force, "solver.extraLineSteps=2");
+  EXPECT_NE(errorOf([&] { parseScene(force, "s.json"); }).find("s.json: solver.extraLineSteps: "), std::string::npos);
+  const Scene switched = withModel(parseScene(document, "s.json"), sim::Model::force, sim::Integrator::verlet);
+  EXPECT_EQ(switched.world.solver.extraLineSteps, 0);
+  EXPECT_EQ(switched.document.find("extraLineSteps"), std::string::npos);
+  EXPECT_EQ(switched.document.find("stretchTolerance"), std::string::npos);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
+#include <tuple>
 #include <vector>
 
 #include "drape/sim/metrics.hpp"
@@ -106,31 +108,34 @@ TEST(Guard, NamesTheFirstParticleThatRunsAwayWhereverItIs) {
 
 TEST(Guard, PutsBackEveryPositionAsItWasBeforeTheBadStepBitForBit) {
   // The position model, its integration making the guard's copy as it goes (one substep or the
-  // first of three), or, with a finger down, a copy made before the finger moves anything. A
-  // particle is sent past the runaway distance on the eleventh step; the world must then hold what
-  // it held after the tenth, every position and previous position.
-  for (const int substeps : {1, 3}) {
-    for (const bool finger : {false, true}) {
-      World world(test::hangingSheet(20, 2, substeps));
-      world.run(9);
-      if (finger) {
-        ASSERT_GT(world.pressFinger(1, world.cloths()[0].state.position[210], 0.08), 0);
-        ASSERT_TRUE(world.moveFinger(1, world.cloths()[0].state.position[210] + Vec3{0.0, 0.05, 0.0}));
-      }
-      ASSERT_EQ(world.step(), StepStatus::ok);
-      std::vector<Cloth> cloths = world.cloths();
-      cloths[0].state.previousPosition[399] -= Vec3{0.0, 0.0, 1e6 * kRunawayDistance};
-      world.restoreCloths(cloths);
-      if (finger) {  // another way than before: the finger sets what the particles held were moving at
-        ASSERT_GT(world.pressFinger(1, world.cloths()[0].state.position[210], 0.08), 0);
-        ASSERT_TRUE(world.moveFinger(1, world.cloths()[0].state.position[210] + Vec3{0.03, 0.0, 0.0}));
-      }
-      const ParticleState before = world.cloths()[0].state;
-      ASSERT_EQ(world.step(), StepStatus::diverged) << substeps << finger;
-      const ParticleState& after = world.cloths()[0].state;
-      EXPECT_EQ(after.position, before.position) << substeps << " substeps, finger " << finger;
-      EXPECT_EQ(after.previousPosition, before.previousPosition) << substeps << " substeps, finger " << finger;
+  // first of three; on a sheet large enough, each of two threads its own part), or, with a finger
+  // down, a copy made before the finger moves anything. The last particle is sent past the runaway
+  // distance on the eleventh step; the world must then hold what it held after the tenth, every
+  // position and previous position.
+  for (const auto& [n, threads, substeps, finger] :
+       {std::tuple{20, 1, 1, false}, {20, 1, 1, true}, {20, 1, 3, false}, {20, 1, 3, true}, {100, 2, 1, false}}) {
+    const std::string what = std::to_string(n) + " x " + std::to_string(n) + ", " + std::to_string(threads) +
+                             " threads, " + std::to_string(substeps) + " substeps, finger " + std::to_string(finger);
+    World world(test::hangingSheet(n, 2, substeps));
+    world.setThreads(threads);
+    world.run(9);
+    if (finger) {
+      ASSERT_GT(world.pressFinger(1, world.cloths()[0].state.position[210], 0.08), 0);
+      ASSERT_TRUE(world.moveFinger(1, world.cloths()[0].state.position[210] + Vec3{0.0, 0.05, 0.0}));
     }
+    ASSERT_EQ(world.step(), StepStatus::ok);
+    std::vector<Cloth> cloths = world.cloths();
+    cloths[0].state.previousPosition.back() -= Vec3{0.0, 0.0, 1e6 * kRunawayDistance};
+    world.restoreCloths(cloths);
+    if (finger) {  // another way than before: the finger sets what the particles held were moving at
+      ASSERT_GT(world.pressFinger(1, world.cloths()[0].state.position[210], 0.08), 0);
+      ASSERT_TRUE(world.moveFinger(1, world.cloths()[0].state.position[210] + Vec3{0.03, 0.0, 0.0}));
+    }
+    const ParticleState before = world.cloths()[0].state;
+    ASSERT_EQ(world.step(), StepStatus::diverged) << what;
+    const ParticleState& after = world.cloths()[0].state;
+    EXPECT_EQ(after.position, before.position) << what;
+    EXPECT_EQ(after.previousPosition, before.previousPosition) << what;
   }
 }
 

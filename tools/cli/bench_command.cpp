@@ -230,12 +230,14 @@ int bench(const BenchArguments& input) {
               "a sweep's two Newton steps with the links' geometric stiffness where a line is taut (`lines`, "
               "`geometricStiffness`), in "
               "substeps of one sweep (how many for each N is below). Where marked (t) the sweep projects the tethers "
-              "again after each of the two Newton steps, and both are full ones (`tethersBetweenSteps`). Where an "
-              "edge is still more than "
-           << percent(bench::Hang2Solver{}.stretchTolerance) << " long after them, the sweep takes up to "
-           << arguments.extraLineSteps
-           << " more line steps (`extraLineSteps`, `stretchTolerance`); \"extra steps\" counts them per frame. "
-              "The naive "
+              "again after each of the two Newton steps, and both are full ones (`tethersBetweenSteps`). "
+           << (arguments.extraLineSteps > 0
+                   ? "Where an edge is still more than " + percent(bench::Hang2Solver{}.stretchTolerance) +
+                         " long after them, the sweep takes up to " + std::to_string(arguments.extraLineSteps) +
+                         " more line steps (`extraLineSteps`, `stretchTolerance`); \"extra steps\" counts them per "
+                         "frame. "
+                   : std::string("The sweep takes no extra line steps (`--extra-line-steps 0`). "))
+           << "The naive "
               "baseline is the textbook loop: an array of particle structs, "
               "Verlet, then Gauss-Seidel sweeps over every constraint in lattice order (`engine/bench/src/naive.cpp`). "
               "Strain is the structural constraints' |x_b - x_a| / r - 1: max and mean at the end, and the worst "

@@ -135,8 +135,9 @@ int main(int argc, char** argv) {
                    "every frame)")
       ->check(CLI::Range(1, 1000));
   benchCommand
-      ->add_flag("--tethers-between-steps", benchArguments.tethersBetweenSteps,
-                 "With --substeps: project the tethers again between the line solve's steps (tethersBetweenSteps)")
+      ->add_flag(
+          "--tethers-between-steps", benchArguments.tethersBetweenSteps,
+          "With --substeps: project the tethers again after each of the line solve's steps (tethersBetweenSteps)")
       ->needs("--substeps");
   benchCommand
       ->add_option("--extra-line-steps", benchArguments.extraLineSteps,

@@ -334,6 +334,7 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
       solverDocument.erase("geometricStiffness");
       solverDocument.erase("tethersBetweenSteps");
       solverDocument.erase("extraLineSteps");
+      solverDocument.erase("stretchTolerance");
     }
     if (document.contains("cloths") && document["cloths"].is_array()) {
       for (json& cloth : document["cloths"]) {

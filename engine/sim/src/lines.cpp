@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <numeric>
 #include <type_traits>
@@ -505,16 +506,58 @@ void solveLoose(Cloth& cloth, const SolverScratch& scratch, Real stiffness, bool
   }
 }
 
-void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
-           Workers& workers, Real* looseLambda) {
+namespace {
+
+// Whether some link of a line, one of whose particles is free to move, is longer than
+// (1 + tolerance) times its rest length. The lines are shared among the workers as the steps share
+// them; any that finds one stops the others looking.
+bool stretchedBeyond(const Cloth& cloth, const SolverScratch& scratch, Real tolerance, Workers& workers) {
+  const Vec3* x = cloth.state.position.data();
+  const Real* w = cloth.state.inverseMass.data();
+  const Real scale = (1.0 + tolerance) * (1.0 + tolerance);
+  std::atomic<bool> found{false};
+  for (const SolverScratch::LineFamily& lines : scratch.lines) {
+    if (lines.start.size() < 2) continue;
+    workers.runShared(lines.start.size() - 1, 8, [&](std::size_t first, std::size_t last, int) {
+      if (found.load(std::memory_order_relaxed)) return;
+      bool beyond = false;
+      for (std::size_t l = first; l < last; ++l) {
+        for (std::size_t k = lines.start[l], end = lines.start[l + 1] - 1; k < end; ++k) {
+          const ParticleIndex a = lines.particle[k], b = lines.particle[k + 1];
+          const Vec3 d = x[b] - x[a];
+          beyond |= glm::dot(d, d) > scale * (lines.rest[k] * lines.rest[k]) && w[a] + w[b] > 0.0;
+        }
+      }
+      if (beyond) found.store(true, std::memory_order_relaxed);
+    });
+    if (found.load()) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+          Workers& workers, Real* looseLambda, const Extra& extra, const std::function<void()>& afterStep) {
   // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
   // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
   // it does not (docs/performance.md). With geometric stiffness the first step is the full Newton
   // step (which keeps kinks from growing) and the second the tridiagonal one (which only refines the
-  // lengths): taking both full costs 1.7 times as much on hang2 for no stiffer a cloth.
-  step(cloth, scratch, stiffness, xpbd, alphaTilde, geometricStiffness, true, workers);
-  step(cloth, scratch, stiffness, xpbd, alphaTilde, geometricStiffness, false, workers);
+  // lengths): taking both full costs 1.7 times as much on hang2 for no stiffer a cloth, unless the
+  // tethers are projected after each (docs/design.md).
+  const auto newtonStep = [&](bool full) {
+    step(cloth, scratch, stiffness, xpbd, alphaTilde, geometricStiffness, full, workers);
+    if (afterStep) afterStep();
+  };
+  newtonStep(true);
+  newtonStep(extra.bothFull);
+  int taken = 0;
+  while (taken < extra.steps && stretchedBeyond(cloth, scratch, extra.tolerance, workers)) {
+    newtonStep(true);
+    ++taken;
+  }
   solveLoose(cloth, scratch, stiffness, xpbd, alphaTilde, looseLambda);
+  return taken;
 }
 
 }  // namespace drape::sim::lines

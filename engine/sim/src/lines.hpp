@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "drape/sim/world.hpp"
 #include "workers.hpp"
@@ -41,10 +42,22 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
 void solveLoose(Cloth& cloth, const SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde,
                 Real* looseLambda);
 
+// How a sweep's stretch solve goes beyond its two Newton steps (solver settings of the same names).
+struct Extra {
+  bool bothFull = false;  // the second step full too (with geometric stiffness), as the first
+  int steps = 0;          // at most this many more full steps ...
+  Real tolerance = 0.0;   // ... while a line's link is longer than (1 + tolerance) times its rest
+};
+
 // A sweep's stretch solve: two Newton steps over every line of both families (the first full with
-// `geometricStiffness`, the second tridiagonal), then the loose stretch constraints.
-void solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
-           Workers& workers, Real* looseLambda);
+// `geometricStiffness`, the second tridiagonal unless extra.bothFull), `afterStep` after each; then,
+// while some link a step can move (one of its particles is free) is over extra.tolerance, up to
+// extra.steps more full steps, each followed by `afterStep`; then the loose stretch constraints.
+// Returns how many more steps it took. Whether a link is over is an OR over the lines, the same
+// however the workers share them.
+int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+          Workers& workers, Real* looseLambda, const Extra& extra = {},
+          const std::function<void()>& afterStep = nullptr);
 
 // At the start of a substep with geometric stiffness: the multipliers the last substep's solves
 // added up become the tension this one's use, and the sums start again from zero.

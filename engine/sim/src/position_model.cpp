@@ -6,9 +6,9 @@
 #include "lines.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cmath>
+#include <functional>
 
 #include <glm/geometric.hpp>
 
@@ -269,30 +269,6 @@ void projectCompliantRange(ParticleState& s, const DistanceConstraint* constrain
     projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
 }
 
-// Whether some stretch constraint is longer than (1 + tolerance) times its rest length. Any
-// thread that finds one stops the others looking; the answer is the same whoever finds it.
-bool stretchedBeyond(const Cloth& cloth, Real tolerance, Workers& workers) {
-  const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
-  const Vec3* x = cloth.state.position.data();
-  const Real scale = (1.0 + tolerance) * (1.0 + tolerance);
-  std::atomic<bool> found{false};
-  workers.run(
-      stretch.size(),
-      [&](std::size_t begin, std::size_t end, int) {
-        for (std::size_t block = begin; block < end && !found.load(std::memory_order_relaxed); block += 1024) {
-          bool beyond = false;
-          for (std::size_t k = block, last = std::min(block + 1024, end); k < last; ++k) {
-            const DistanceConstraint& c = stretch[k];
-            const Vec3 d = x[c.b] - x[c.a];
-            beyond |= glm::dot(d, d) > scale * (c.restLength * c.restLength);
-          }
-          if (beyond) found.store(true, std::memory_order_relaxed);
-        }
-      },
-      4096);
-  return found.load();
-}
-
 }  // namespace
 
 namespace {
@@ -318,7 +294,8 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
 // The fast sweep (solver.lines): tethers first, then bend and shear in batches shared among the
 // workers, then the stretch constraints a line at a time, last, so that a sweep ends with what
 // matters most to the eye, the cloth's length. With solver.tethersBetweenSteps the tethers are
-// projected again between the lines' two Newton steps.
+// projected again after each of the lines' Newton steps; with solver.extraLineSteps the lines take
+// more steps while a link is over solver.stretchTolerance (lines::solve).
 void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, Workers& workers) {
   ParticleState& s = cloth.state;
   const auto tethers = [&] {
@@ -338,21 +315,13 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     if (kind == ConstraintKind::stretch) {
       const Real stiffness = solver.xpbd ? 1.0 : material.stiffness;
       Real* looseLambda = scratch.lambda[kindIndex].data();
-      const bool gs = solver.geometricStiffness, between = solver.tethersBetweenSteps;
-      const auto step = [&](bool full) {
-        lines::step(cloth, scratch, stiffness, solver.xpbd, alphaTilde, gs, full, workers);
-        if (between) tethers();
-      };
-      // Two Newton steps (lines::solve); with the tethers between, both full and the tethers after
-      // each: the tethers keep the edges beside a pin from being pulled long by the last step.
-      step(true);
-      step(between);
-      for (int extra = 0; extra < solver.extraLineSteps && stretchedBeyond(cloth, solver.stretchTolerance, workers);
-           ++extra) {
-        step(true);
-        ++scratch.extraLineSteps;
-      }
-      lines::solveLoose(cloth, scratch, stiffness, solver.xpbd, alphaTilde, looseLambda);
+      // With the tethers between the line steps both steps are full and the tethers follow each,
+      // the last too: they keep the edges beside a pin from being pulled long by the last step.
+      const bool between = solver.tethersBetweenSteps;
+      scratch.extraLineSteps +=
+          lines::solve(cloth, scratch, stiffness, solver.xpbd, alphaTilde, solver.geometricStiffness, workers,
+                       looseLambda, {between, solver.extraLineSteps, solver.stretchTolerance},
+                       between ? std::function<void()>(tethers) : nullptr);
       continue;
     }
     const DistanceConstraint* constraints = cloth.rest.of(kind).data();

@@ -36,8 +36,8 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
 // stiffness k:  dx_a = k w_a / (w_a + w_b) (|x_b - x_a| - r) (x_b - x_a) / |x_b - x_a|,
 //               dx_b = -k w_b / (w_a + w_b) (...)
 // With equal masses and k = 1 that is exactly the seed's dx_1 = 1/2 (|x2 - x1| - r)(x2 - x1)/|x2 - x1|.
-// Each sweep starts with the tethers (scratch.tethers), if any (and projects them again between
-// the lines' Newton steps with solver.tethersBetweenSteps). With `contacts`, the contact
+// Each sweep starts with the tethers (scratch.tethers), if any (and projects them again after each
+// of the lines' Newton steps with solver.tethersBetweenSteps). With `contacts`, the contact
 // planes are re-enforced after every sweep, so the constraints cannot pull a particle back into a
 // collider. With solver.xpbd each kind resists with its compliance instead (see settings.hpp); with
 // solver.lines the stretch constraints are solved a line at a time (lines.hpp; scratch.lines

@@ -61,13 +61,14 @@ struct SolverSettings {
   // Position model, with lines and tethers: the tethers are projected again after each of the line
   // solve's two Newton steps, and with geometric stiffness both steps are full. A tether's pull and
   // the lines' lengths then settle together within a sweep instead of across substeps: a fine
-  // stiff cloth hanging from pins needs half the substeps or fewer, each about a third dearer.
+  // stiff cloth hanging from pins needs half the substeps or fewer, each about a quarter dearer.
   bool tethersBetweenSteps = false;
-  // Position model, with lines: after a sweep's line steps, while some stretch constraint is longer
-  // than (1 + stretchTolerance) times its rest length, one more Newton step of every line (full
-  // with geometric stiffness, and the tethers after it with tethersBetweenSteps), at most
-  // extraLineSteps times a sweep. A frame that jerks the cloth (the first fall, a finger's yank)
-  // pays for the steps it needs; the others pay one pass that checks. 0: never.
+  // Position model, with lines: after a sweep's line steps, while some line's link that a step can
+  // move (not one between two pinned or held particles) is longer than (1 + stretchTolerance)
+  // times its rest length, one more Newton step of every line (full with geometric stiffness, and
+  // the tethers after it with tethersBetweenSteps), at most extraLineSteps times a sweep. A frame
+  // that jerks the cloth (the first fall, a finger's yank) pays for the steps it needs; the others
+  // pay one pass that checks. 0: never.
   int extraLineSteps = 0;
   Real stretchTolerance = 0.04;
 };

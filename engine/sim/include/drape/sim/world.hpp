@@ -91,8 +91,9 @@ class World {
   std::size_t memoryBytes() const;
   MemoryUse memoryUse() const;
   std::size_t tetherCount() const;
-  // Line steps the sweeps have taken beyond their two, because the cloth was stretched beyond
-  // solver.stretchTolerance (solver.extraLineSteps), since the world was made or its cloths replaced.
+  // Line steps the sweeps of the cloths there are now have taken beyond their two, because the
+  // cloth was stretched beyond solver.stretchTolerance (solver.extraLineSteps), since the world was
+  // made or its cloths replaced.
   std::int64_t extraLineSteps() const;
 
   StepStatus step();
