@@ -717,6 +717,23 @@ TEST(FastSweep, ExtraLineStepsLeaveEveryEdgeWithinTheToleranceUnlessTheyRunOut) 
   EXPECT_LT(extraWorst, 0.8 * plainWorst);
 }
 
+// A particle with three stretch links along x, each 50 % longer than at rest: one of them cannot
+// join a line (a particle has at most two links in a family) and is loose.
+Cloth threeLinksAlongX() {
+  Cloth cloth;
+  cloth.rest.restPositions = {Vec3{0.0}, Vec3{1.0, 0.0, 0.0}, Vec3{-1.0, 0.0, 0.0}, Vec3{1.0, 0.0, 0.1}};
+  for (ParticleIndex i = 1; i <= 3; ++i) {
+    cloth.rest.constraints[0].push_back({0, i, glm::length(cloth.rest.restPositions[i])});
+  }
+  cloth.state.position = cloth.rest.restPositions;
+  for (Vec3& x : cloth.state.position) x *= 1.5;
+  cloth.state.previousPosition = cloth.state.position;
+  cloth.state.inverseMass.assign(4, 1.0);
+  cloth.state.mass.assign(4, 1.0);
+  cloth.state.pinned.assign(4, 0);
+  return cloth;
+}
+
 TEST(FastSweep, ExtraLineStepsAreNotSpentOnLinksTheLinesCannotShorten) {
   // Two kinds of link no line step changes, each over the tolerance at every sweep: one between two
   // pins held 30 % farther apart than at rest, and a loose link (projected one by one after the line
@@ -736,18 +753,8 @@ TEST(FastSweep, ExtraLineStepsAreNotSpentOnLinksTheLinesCannotShorten) {
   EXPECT_NEAR(structuralStrain(world).max, 0.3, 1e-9);
   EXPECT_EQ(world.extraLineSteps(), 0);
 
-  // The loose link: a particle with three links along x, all 50 % long; two join lines.
-  Cloth cloth;
-  cloth.rest.restPositions = {Vec3{0.0}, Vec3{1.0, 0.0, 0.0}, Vec3{-1.0, 0.0, 0.0}, Vec3{1.0, 0.0, 0.1}};
-  for (ParticleIndex i = 1; i <= 3; ++i) {
-    cloth.rest.constraints[0].push_back({0, i, glm::length(cloth.rest.restPositions[i])});
-  }
-  cloth.state.position = cloth.rest.restPositions;
-  for (Vec3& x : cloth.state.position) x *= 1.5;
-  cloth.state.previousPosition = cloth.state.position;
-  cloth.state.inverseMass.assign(4, 1.0);
-  cloth.state.mass.assign(4, 1.0);
-  cloth.state.pinned.assign(4, 0);
+  // The loose link.
+  Cloth cloth = threeLinksAlongX();
   SolverScratch scratch;
   lines::build(cloth, scratch, 1);
   ASSERT_EQ(scratch.looseStretch.size(), 1u);
@@ -1086,17 +1093,7 @@ TEST(FastSweep, ThreadsSplittingTautAndSlackLinesStayBitIdentical) {
 TEST(Lines, XpbdLooseLinksKeepTheirCompliance) {
   // A particle with three links along x: one of them cannot join a line and is projected alone.
   // Very compliant, it must barely move, as the lines do; rigid, it would snap back to rest.
-  Cloth cloth;
-  cloth.rest.restPositions = {Vec3{0.0}, Vec3{1.0, 0.0, 0.0}, Vec3{-1.0, 0.0, 0.0}, Vec3{1.0, 0.0, 0.1}};
-  for (ParticleIndex i = 1; i <= 3; ++i) {
-    cloth.rest.constraints[0].push_back({0, i, glm::length(cloth.rest.restPositions[i])});
-  }
-  cloth.state.position = cloth.rest.restPositions;
-  for (Vec3& x : cloth.state.position) x *= 1.5;
-  cloth.state.previousPosition = cloth.state.position;
-  cloth.state.inverseMass.assign(4, 1.0);
-  cloth.state.mass.assign(4, 1.0);
-  cloth.state.pinned.assign(4, 0);
+  Cloth cloth = threeLinksAlongX();
   SolverScratch scratch;
   lines::build(cloth, scratch, 1);
   ASSERT_EQ(scratch.looseStretch.size(), 1u);
