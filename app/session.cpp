@@ -144,7 +144,7 @@ sim::StepStatus Session::step() {
   if (result == sim::StepStatus::diverged) {
     const sim::Divergence d = *world_->divergence();
     status = "diverged at step " + std::to_string(d.step) + " (cloth " + std::to_string(d.cloth) + " particle " +
-             std::to_string(d.particle) + "): back to the last good state, paused";
+             std::to_string(d.particle) + "): back to the last good positions, at rest, paused";
     interaction_->cancelAll();
     world_->clearDivergence();
     paused = true;

@@ -52,8 +52,8 @@ class Session {
   // Applies changed settings (from the panels); returns a message when they are refused.
   std::optional<std::string> tune(const sim::WorldSettings& settings);
 
-  // One step of the world, fingers first. On a divergence the world is back at its last good state,
-  // the session pauses and says so in `status`.
+  // One step of the world, fingers first. On a divergence the world is back at its last good
+  // positions, at rest, and the session pauses and says so in `status`.
   sim::StepStatus step();
 
   // Takes back the last cloth drawn or the last cut. False when there is nothing to take back.

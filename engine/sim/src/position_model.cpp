@@ -70,7 +70,7 @@ void keptAll() {
 }  // namespace
 
 void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
-               Workers& workers, Vec3* keepPosition, Vec3* keepPrevious) {
+               Workers& workers, Vec3* keepPosition) {
   ParticleState& s = cloth.state;
   // Exact for du/dt = a - k u over one substep: u' = u e^{-kh} + a h (1 - e^{-kh}) / (k h).
   const Real kh = (world.solver.damping + world.air.drag) * h;
@@ -82,10 +82,7 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
       s.position.size(),
       [&](std::size_t begin, std::size_t end, int) {
         for (std::size_t i = begin; i < end; ++i) {
-          if (keepPosition) {
-            keep(keepPosition + i, s.position[i]);
-            keep(keepPrevious + i, s.previousPosition[i]);
-          }
+          if (keepPosition) keep(keepPosition + i, s.position[i]);
           if (s.inverseMass[i] == 0.0) {
             // Pinned or held: no force moves it, only the world does. It carries on as it was set to move
             // (a finger sets x_prev one finger step behind); a pin has x_prev = x and stays exactly put.

@@ -25,10 +25,10 @@ void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, 
 // a = g + drag wind + a_extra. With k = 0 this is the seed's Verlet step; with k > 0 it is the exact
 // solution of du/dt = a - k u over the substep, so no damping or drag can make it overshoot and a
 // falling particle reaches exactly the terminal velocity a / k. Pinned particles (inverse mass 0)
-// do not move. With `keepPosition` and `keepPrevious` each particle's position and previous position
-// are also copied there as they were before the step (the guard's copy, made in the same pass).
+// do not move. With `keepPosition` each particle's position is also copied there as it was before
+// the step (the guard's copy, made in the same pass).
 void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
-               Workers& workers, Vec3* keepPosition = nullptr, Vec3* keepPrevious = nullptr);
+               Workers& workers, Vec3* keepPosition = nullptr);
 
 // `solver.iterations` Gauss-Seidel sweeps over the stretch, shear and bend constraints, in the
 // batches of scratch (batches.hpp; built for the cloth's current constraints). Each violated

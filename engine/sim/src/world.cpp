@@ -358,9 +358,7 @@ MemoryUse World::memoryUse() const {
                  bytes(f.tensionSum) + bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
     }
   }
-  for (const Snapshot& snapshot : lastGood_) {
-    m.guard += bytes(snapshot.position) + bytes(snapshot.previousPosition) + bytes(snapshot.velocity);
-  }
+  for (const std::vector<Vec3>& good : lastGood_) m.guard += bytes(good);
   for (const std::vector<std::uint8_t>& held : held_) m.solver += bytes(held);
   const SelfCollisionScratch& h = selfCollisionScratch_;
   m.solver += bytes(h.owner) + bytes(h.cell) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
@@ -433,10 +431,9 @@ void World::runStage(Stage stage) {
     switch (stage) {
       case Stage::windPressure: position::accumulateWindPressure(cloth, settings_.air, h, scratch.acceleration); break;
       case Stage::verletIntegrate: {
-        Snapshot* keep = keepInIntegrate_ && substep_ == 0 ? &lastGood_[c] : nullptr;
+        const bool keep = guardCopy_ == GuardCopy::integration && substep_ == 0;
         position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration,
-                            *workers_, keep ? keep->position.data() : nullptr,
-                            keep ? keep->previousPosition.data() : nullptr);
+                            *workers_, keep ? lastGood_[c].data() : nullptr);
         break;
       }
       case Stage::projectConstraints:
@@ -524,27 +521,42 @@ StepStatus World::step() {
   using Clock = std::chrono::steady_clock;
   if (divergence_) return StepStatus::diverged;
   if (!historyStarted_) startHistory();
-  // Only what a step changes is kept (inverse masses do not change within a step). Where the
-  // position model's integration is the first stage to change anything (no finger moves particles
-  // before it), it copies them as it reads them, in the same pass.
-  keepInIntegrate_ = settings_.solver.model == Model::position && !hasStage(Stage::fingers);
+  // The guard goes back to the positions before the step, at rest: no copy where one substep of the
+  // position model leaves them in the previous positions (its integration sets x_prev = x and no
+  // stage after it writes x_prev); else a copy, made by that integration as it reads them where
+  // it is the first stage to change anything (no finger moves particles before it).
+  const bool position = settings_.solver.model == Model::position;
+  const auto onlyPositionsAfterIntegration = [&] {
+    for (const StageTiming& timing : profile_) {
+      switch (timing.stage) {
+        case Stage::windPressure:
+        case Stage::verletIntegrate:
+        case Stage::projectConstraints:
+        case Stage::collide:
+        case Stage::guard:
+        case Stage::tear: break;
+        default: return false;
+      }
+    }
+    return true;
+  };
+  guardCopy_ = position && settings_.solver.substeps == 1 && onlyPositionsAfterIntegration() ? GuardCopy::none
+               : position && !hasStage(Stage::fingers)                                       ? GuardCopy::integration
+                                                                                             : GuardCopy::before;
   lastGood_.resize(cloths_.size());
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    const ParticleState& s = cloths_[c].state;
-    Snapshot& good = lastGood_[c];
-    good.position.resize(s.position.size());
-    good.previousPosition.resize(s.previousPosition.size());
-    good.velocity.resize(s.velocity.size());
-    if (keepInIntegrate_ && s.velocity.empty()) continue;
+    std::vector<Vec3>& good = lastGood_[c];
+    const std::vector<Vec3>& x = cloths_[c].state.position;
+    if (guardCopy_ == GuardCopy::none) {
+      good = {};
+      continue;
+    }
+    good.resize(x.size());
+    if (guardCopy_ == GuardCopy::integration) continue;
     workers_->run(
-        s.position.size(),
+        x.size(),
         [&](std::size_t begin, std::size_t end, int) {
-          std::copy(s.position.begin() + begin, s.position.begin() + end, good.position.begin() + begin);
-          std::copy(s.previousPosition.begin() + begin, s.previousPosition.begin() + end,
-                    good.previousPosition.begin() + begin);
-          if (!s.velocity.empty()) {
-            std::copy(s.velocity.begin() + begin, s.velocity.begin() + end, good.velocity.begin() + begin);
-          }
+          std::copy(x.begin() + begin, x.begin() + end, good.begin() + begin);
         },
         4096);
   }
@@ -571,9 +583,13 @@ StepStatus World::step() {
   if (divergence_) {
     for (std::size_t c = 0; c < cloths_.size(); ++c) {
       ParticleState& s = cloths_[c].state;
-      s.position = lastGood_[c].position;
-      s.previousPosition = lastGood_[c].previousPosition;
-      s.velocity = lastGood_[c].velocity;
+      if (guardCopy_ == GuardCopy::none) {
+        s.position = s.previousPosition;
+      } else {
+        s.position = lastGood_[c];
+        s.previousPosition = lastGood_[c];
+      }
+      std::fill(s.velocity.begin(), s.velocity.end(), Vec3{0.0});
     }
     for (Collider& collider : colliders_) collider.setTime(time());  // back where the good state saw them
     return StepStatus::diverged;

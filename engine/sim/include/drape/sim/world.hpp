@@ -63,7 +63,7 @@ struct MemoryUse {
   std::size_t tethers = 0;
   std::size_t lines = 0;   // the fast sweep's rows and columns
   std::size_t solver = 0;  // scratch: contacts, wind, multipliers, batches, line solves, fingers, self-collision
-  std::size_t guard = 0;   // the copy of the last good state a divergence goes back to
+  std::size_t guard = 0;   // the copy of the last good positions a divergence goes back to
   std::size_t total() const { return state + rest + constraints + topology + tethers + lines + solver + guard; }
 };
 
@@ -87,7 +87,7 @@ class World {
   void setThreads(int threads);
   int threads() const;
   // Bytes the world keeps for its cloths (every array's capacity: state, rest data, constraints,
-  // solver scratch, the guard's copy of the last good state).
+  // solver scratch, the guard's copy of the last good positions).
   std::size_t memoryBytes() const;
   MemoryUse memoryUse() const;
   std::size_t tetherCount() const;
@@ -96,6 +96,9 @@ class World {
   // made or its cloths replaced.
   std::int64_t extraLineSteps() const;
 
+  // One step. If it leaves a position non-finite or beyond kRunawayDistance (the guard stage), the
+  // cloths go back to where they were before it, at rest (their velocities ran away: they are not
+  // given back), and the step returns diverged and does not count.
   StepStatus step();
   StepStatus run(std::int64_t steps);
 
@@ -151,8 +154,8 @@ class World {
   // (`next.cloths` is ignored). Velocities are kept across a change of step. Throws
   // std::invalid_argument, changing nothing, when `next` is not valid or changes what cannot.
   void tune(const WorldSettings& next);
-  // After a divergence the world holds its last good state and refuses to step; this lets it go on
-  // from there (after tuning it, say).
+  // After a divergence the world holds its last good positions, at rest, and refuses to step; this
+  // lets it go on from there (after tuning it, say).
   void clearDivergence() { divergence_.reset(); }
 
   // Adds a cloth while the world runs (it starts at rest) and returns its index; throws
@@ -192,11 +195,14 @@ class World {
   std::vector<Collider> colliders_;
   SelfCollisionScratch selfCollisionScratch_;
   int substep_ = 0;  // within the current step
-  struct Snapshot {
-    std::vector<Vec3> position, previousPosition, velocity;
+  // Where the guard finds the positions before the current step (World::step).
+  enum class GuardCopy : std::uint8_t {
+    none,         // in the previous positions: one substep's integration left them there untouched
+    integration,  // in lastGood_, copied by the first substep's integration as it reads them
+    before,       // in lastGood_, copied before the step
   };
-  std::vector<Snapshot> lastGood_;  // what the current step changes, as it was before it
-  bool keepInIntegrate_ = false;    // this step's integration makes lastGood_ (World::step)
+  GuardCopy guardCopy_ = GuardCopy::before;
+  std::vector<std::vector<Vec3>> lastGood_;  // per cloth, unless guardCopy_ is none
   std::vector<Finger> fingers_;
   std::vector<std::vector<std::uint8_t>> held_;  // per cloth and particle: 1 while a finger holds it
   std::unique_ptr<Workers> workers_;
