@@ -344,9 +344,16 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
   // severed around waits for the next pass (and its own strain then), so neighbouring cracks do not
   // cut out slivers and islands between them.
   std::vector<std::uint8_t> near(rest.particleCount(), 0);
+  // A free link (no triangle: a chain) breaks alone in its piece: the most strained one, which lets
+  // the rest go. Where links are strained alike (a chain pulled evenly), which of them crosses the
+  // threshold first is rounding, and breaking them all would shatter the chain.
+  std::vector<std::uint32_t> letGo;  // pieces a free link of has broken this pass
   for (const auto& [ratio, j] : strained) {
     ConstraintTemplate& x = topology.templates[topology.source[static_cast<std::size_t>(ConstraintKind::stretch)][j]];
     if (x.link == ConstraintTemplate::Link::free) {
+      const std::uint32_t piece = stretch[j].a < cloth.piece.size() ? cloth.piece[stretch[j].a] : 0;
+      if (std::find(letGo.begin(), letGo.end(), piece) != letGo.end()) continue;
+      letGo.push_back(piece);
       x.broken = true;
       ++topology.torn;
       changed = true;
