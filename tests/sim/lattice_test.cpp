@@ -22,13 +22,14 @@ TEST(Lattice, RestLengthsAreTheSpacing) {
   const auto alongX = [&](const DistanceConstraint& c) {
     return rest.restPositions[c.a].z == rest.restPositions[c.b].z;
   };
+  // Rest lengths are single precision (RestReal): the nearest float, give or take an ulp or two.
   for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) {
-    EXPECT_NEAR(c.restLength, alongX(c) ? 0.25 : 0.2, 1e-12);
+    EXPECT_FLOAT_EQ(c.restLength, alongX(c) ? 0.25f : 0.2f);
   }
   for (const DistanceConstraint& c : rest.of(ConstraintKind::shear))
-    EXPECT_NEAR(c.restLength, std::hypot(0.25, 0.2), 1e-12);
+    EXPECT_FLOAT_EQ(c.restLength, static_cast<float>(std::hypot(0.25, 0.2)));
   for (const DistanceConstraint& c : rest.of(ConstraintKind::bend))
-    EXPECT_NEAR(c.restLength, alongX(c) ? 0.5 : 0.4, 1e-12);
+    EXPECT_FLOAT_EQ(c.restLength, alongX(c) ? 0.5f : 0.4f);
 }
 
 TEST(Lattice, IndexIsRowMajorAndPlanesPointTheRightWay) {

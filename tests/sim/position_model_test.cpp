@@ -17,7 +17,7 @@ TEST(PositionModel, OneProjectionRestoresRestLengthAsTheSeedWrites) {
   // Seed: dx1 = 1/2 (|x2 - x1| - r) (x2 - x1) / |x2 - x1|, dx2 = -dx1.
   std::vector<Vec3> x = {{0.0, 0.0, 0.0}, {1.2, 1.6, 0.0}};  // |x2 - x1| = 2
   const std::vector<Real> w = {1.0, 1.0};
-  const Real r = 1.0;
+  const RestReal r = 1.0f;
   const Vec3 d = x[1] - x[0];
   const Vec3 dx1 = 0.5 * (glm::length(d) - r) * d / glm::length(d);
   const std::vector<Vec3> expected = {x[0] + dx1, x[1] - dx1};

@@ -1,6 +1,7 @@
 #include "drape/scene/snapshot.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -122,9 +123,10 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
                                           [&](const json& k) -> std::optional<sim::DistanceConstraint> {
                                             const auto a = index(k[0]), b = index(k[1]);
                                             const double rest = k[2].get<double>();
-                                            if (!a || !b || *a == *b || !std::isfinite(rest) || rest < 0.0)
+                                            if (!a || !b || *a == *b || !std::isfinite(rest) || rest < 0.0 ||
+                                                rest > std::numeric_limits<sim::RestReal>::max())
                                               return std::nullopt;
-                                            return sim::DistanceConstraint{*a, *b, rest};
+                                            return sim::DistanceConstraint{*a, *b, static_cast<sim::RestReal>(rest)};
                                           });
     }
     sim::ParticleState& s = cloth.state;

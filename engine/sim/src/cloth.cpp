@@ -30,7 +30,7 @@ std::string_view name(LatticePlane plane) {
 namespace {
 
 void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
-  const Real restLength = glm::length(rest.restPositions[b] - rest.restPositions[a]);
+  const auto restLength = static_cast<RestReal>(glm::length(rest.restPositions[b] - rest.restPositions[a]));
   rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
 }
 

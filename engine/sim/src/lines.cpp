@@ -30,9 +30,10 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
 // overlap the lines' chains of divisions (Thomas' recurrence is serial within a line).
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
 template <std::size_t G>
-void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, const std::array<const Real*, G>& rest,
-                const std::array<Real*, G>& lambda, const std::array<float*, G>& tensionSum, std::size_t n,
-                Real stiffness, Real alphaTilde, Vec3* normal, Real* upper, Real* solution) {
+void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
+                const std::array<const RestReal*, G>& rest, const std::array<Real*, G>& lambda,
+                const std::array<float*, G>& tensionSum, std::size_t n, Real stiffness, Real alphaTilde, Vec3* normal,
+                Real* upper, Real* solution) {
   const std::size_t links = n - 1;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -115,7 +116,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p, 
 // (FixedG: the number of lines G when it is known at compile time, a full group; 0: given as count.)
 template <std::size_t W, std::size_t FixedG>
 void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const ParticleIndex*, W>& p,
-                     const std::array<const Real*, W>& rest, const std::array<Real*, W>& lambda,
+                     const std::array<const RestReal*, W>& rest, const std::array<Real*, W>& lambda,
                      const std::array<const float*, W>& tension, const std::array<float*, W>& tensionSum, std::size_t n,
                      Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
   static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
@@ -213,7 +214,7 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
 template <std::size_t N>
 struct LineData {
   std::array<const ParticleIndex*, N> p{};
-  std::array<const Real*, N> rest{};
+  std::array<const RestReal*, N> rest{};
   std::array<Real*, N> lambda{};
   std::array<std::size_t, N> offset{};
 };
@@ -348,7 +349,7 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
           if (candidate >= 0 && candidate != from) link = candidate;
         }
         if (link < 0) {
-          lines.rest.push_back(0.0);
+          lines.rest.push_back(0.0f);
           break;
         }
         const DistanceConstraint& c = stretch[static_cast<std::size_t>(link)];
@@ -525,7 +526,8 @@ bool stretchedBeyond(const Cloth& cloth, const SolverScratch& scratch, Real tole
         for (std::size_t k = lines.start[l], end = lines.start[l + 1] - 1; k < end; ++k) {
           const ParticleIndex a = lines.particle[k], b = lines.particle[k + 1];
           const Vec3 d = x[b] - x[a];
-          beyond |= glm::dot(d, d) > scale * (lines.rest[k] * lines.rest[k]) && w[a] + w[b] > 0.0;
+          const Real r = lines.rest[k];
+          beyond |= glm::dot(d, d) > scale * (r * r) && w[a] + w[b] > 0.0;
         }
       }
       if (beyond) found.store(true, std::memory_order_relaxed);

@@ -45,7 +45,7 @@ __m256d ones(__m256d holds) { return _mm256_and_pd(holds, _mm256_set1_pd(1.0)); 
 
 void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const double* position,
                            const double* inverseMass, const double* mass, const std::uint32_t* first,
-                           const double* const* rest, const double* const* lambda, const float* const* tension,
+                           const float* const* rest, const double* const* lambda, const float* const* tension,
                            const double* perUnitMass, double alphaTilde) {
   const std::size_t links = n - 1;
   const __m256d zero = _mm256_setzero_pd(), alpha = _mm256_set1_pd(alphaTilde);

@@ -17,7 +17,7 @@ void solveStiffLanesWide(SolverScratch::StiffRows* rows, std::size_t n, const fl
 // same rows[0, n), bit for bit. rest, lambda (null entries without XPBD) and tension: each line's.
 void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const double* position,
                            const double* inverseMass, const double* mass, const std::uint32_t* first,
-                           const double* const* rest, const double* const* lambda, const float* const* tension,
+                           const float* const* rest, const double* const* lambda, const float* const* tension,
                            const double* perUnitMass, double alphaTilde);
 // ... and its scatter of the moves (the multipliers are the caller's): each particle that moves by
 // yx * stiffness.

@@ -238,7 +238,7 @@ void projectTethers(ParticleState& s, const SolverScratch::Tethers& tethers, std
       for (std::size_t i = from; i < to; ++i) {
         const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
         if (w[particle] == 0.0) continue;
-        const Real* length = tethers.length.data() + run.lengths + 2 * i;
+        const RestReal* length = tethers.length.data() + run.lengths + 2 * i;
         x[particle] = intoLens(x[particle], a, length[0], b, length[1], axis);
       }
       continue;
@@ -246,7 +246,7 @@ void projectTethers(ParticleState& s, const SolverScratch::Tethers& tethers, std
     for (std::size_t i = from; i < to; ++i) {
       const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
       if (w[particle] == 0.0) continue;
-      const Real* length = tethers.length.data() + run.lengths + i * run.pinCount;
+      const RestReal* length = tethers.length.data() + run.lengths + i * run.pinCount;
       for (std::uint32_t j = 0; j < run.pinCount; ++j) {
         if (w[pin[j]] == 0.0) x[particle] = intoBall(x[particle], x[pin[j]], length[j]);
       }

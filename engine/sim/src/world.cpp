@@ -222,7 +222,7 @@ void World::buildTethers(std::size_t c) {
     for (const std::size_t p : pins) {
       if (cloth.piece[i] != cloth.piece[p]) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
-      const Real length = glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]);
+      const auto length = static_cast<RestReal>(glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]));
       tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
     }
   }

@@ -27,7 +27,7 @@ std::string_view name(ConstraintKind kind);
 struct DistanceConstraint {
   ParticleIndex a;
   ParticleIndex b;
-  Real restLength;  // m
+  RestReal restLength;  // m
 };
 
 // Which world plane the lattice is laid out in at rest.

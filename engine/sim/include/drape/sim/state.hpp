@@ -46,7 +46,7 @@ struct SolverScratch {
     struct Tether {  // one, as they are built and filtered (list, assign)
       ParticleIndex particle;
       ParticleIndex pin;
-      Real length;  // m, the longest they may be apart
+      RestReal length;  // m, the longest they may be apart
     };
     struct Run {
       ParticleIndex first;  // particles first .. first + count
@@ -58,7 +58,7 @@ struct SolverScratch {
     };
     std::vector<Run> run;
     std::vector<ParticleIndex> pin;
-    std::vector<Real> length;
+    std::vector<RestReal> length;
 
     bool empty() const { return run.empty(); }
     std::size_t size() const { return length.size(); }  // tethers
@@ -75,8 +75,8 @@ struct SolverScratch {
   struct LineFamily {
     std::vector<std::uint32_t> start;  // line l holds particle[start[l] .. start[l + 1])
     std::vector<ParticleIndex> particle;
-    std::vector<Real> rest;    // m, link k joins particle[k] and particle[k + 1] (unused at a line's end)
-    std::vector<Real> lambda;  // XPBD: multiplier of link k, reset each substep
+    std::vector<RestReal> rest;  // m, link k joins particle[k] and particle[k + 1] (unused at a line's end)
+    std::vector<Real> lambda;    // XPBD: multiplier of link k, reset each substep
     // solver.geometricStiffness: the sum of link k's multipliers over the last substep (its
     // tension times h^2, negative when pulled), and over this one so far. Single precision: they
     // only scale the geometric stiffness, and choose which lines take the full step.

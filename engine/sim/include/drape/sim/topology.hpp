@@ -30,7 +30,7 @@ struct ConstraintTemplate {
     through,  // a in t1, b in t2, and t1's corner `middle1` is t2's corner `middle2`
     free,     // no triangle: a = t1, b = t2 are particles; `broken` once torn or cut
   };
-  Real restLength = 0.0;
+  RestReal restLength = 0.0f;
   std::uint32_t t1 = 0, t2 = 0;
   ConstraintKind kind = ConstraintKind::stretch;
   Link link = Link::same;
