@@ -174,7 +174,7 @@ TEST(Lines, TheStiffSolveGivesTheSameBitsEightLinesAtATimeAsFour) {
     for (int sweep = 0; sweep < 2; ++sweep) {
       lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
       for (const SolverScratch::LineFamily& family : scratch.lines) {
-        tensions.insert(tensions.end(), family.tensionSum.begin(), family.tensionSum.end());
+        tensions.insert(tensions.end(), family.tension.begin(), family.tension.end());
       }
       lines::beginSubstep(scratch);
     }

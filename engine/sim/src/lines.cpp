@@ -32,8 +32,8 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
 template <std::size_t G>
 void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                 const std::array<const RestReal*, G>& rest, const std::array<Real*, G>& lambda,
-                const std::array<float*, G>& tensionSum, std::size_t n, Real stiffness, Real alphaTilde, Vec3* normal,
-                Real* upper, Real* solution) {
+                const std::array<float*, G>& tensionSum, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
+                Vec3* normal, Real* upper, Real* solution) {
   const std::size_t links = n - 1;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -88,7 +88,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
       const std::size_t at = k * G + g;
       const Real dl = solution[at] * stiffness;
       if (lambda[g]) lambda[g][k] += dl;
-      if (tensionSum[g]) tensionSum[g][k] = static_cast<float>(tensionSum[g][k] + dl);
+      if (tensionSum[g]) tensionSum[g][k] = static_cast<float>((restart ? 0.0f : tensionSum[g][k]) + dl);
       const Vec3 push = normal[at] * dl;
       x[p[g][k]] -= push * w[p[g][k]];
       x[p[g][k + 1]] += push * w[p[g][k + 1]];
@@ -117,8 +117,8 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
 template <std::size_t W, std::size_t FixedG>
 void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const ParticleIndex*, W>& p,
                      const std::array<const RestReal*, W>& rest, const std::array<Real*, W>& lambda,
-                     const std::array<const float*, W>& tension, const std::array<float*, W>& tensionSum, std::size_t n,
-                     Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
+                     const std::array<const float*, W>& tension, const std::array<float*, W>& tensionSum, bool restart,
+                     std::size_t n, Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
   static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
   // Eight lines whose particles at each k are consecutive (p[g][k] = p[0][k] + g) are gathered and
   // scattered eight particles at a time (lines_wide.cpp): the same bits as below.
@@ -204,7 +204,7 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;
-      tensionSum[g][j - 1] = static_cast<float>(tensionSum[g][j - 1] + multiplier);
+      tensionSum[g][j - 1] = static_cast<float>((restart ? 0.0f : tensionSum[g][j - 1]) + multiplier);
     }
   }
 }
@@ -380,8 +380,7 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
 
 void beginSubstep(SolverScratch& scratch) {
   for (SolverScratch::LineFamily& lines : scratch.lines) {
-    lines.tension.swap(lines.tensionSum);
-    std::fill(lines.tensionSum.begin(), lines.tensionSum.end(), 0.0f);
+    lines.fresh = true;
     lines.ordered = false;
   }
 }
@@ -395,7 +394,6 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
     for (SolverScratch::LineFamily& lines : scratch.lines) {  // sized here alone (zero: no tension yet)
       lines.tension.resize(lines.rest.size(), 0.0f);
-      lines.tensionSum.resize(lines.rest.size(), 0.0f);
     }
   }
   for (SolverScratch::LineFamily& lines : scratch.lines) {
@@ -434,6 +432,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
       std::iota(lines.order.begin(), lines.order.end(), 0u);
     }
     const std::size_t taut = fullStep ? lines.tautCount : 0;
+    // A substep's first step starts its sum: it reads the last substep's and writes its own.
+    const bool restart = lines.fresh;
     for (const bool stiff : {true, false}) {
       const std::size_t from = stiff ? 0 : taut, to = stiff ? taut : count;
       if (from == to) continue;
@@ -449,11 +449,13 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                 inLanes<W>(lines, line, last - first, xpbd,
                            [&](std::size_t G, const auto& p, const auto& rest, const auto& lambda, const auto& offset,
                                std::size_t n, const std::uint32_t* ids) {
+                             // The tension is read and summed in the same array: a line's gather
+                             // reads its links' before its scatter adds to them.
                              std::array<const float*, W> tension{};
                              std::array<float*, W> tensionSum{};
                              for (std::size_t g = 0; g < G; ++g) {
                                tension[g] = lines.tension.data() + offset[g];
-                               tensionSum[g] = lines.tensionSum.data() + offset[g];
+                               tensionSum[g] = lines.tension.data() + offset[g];
                              }
                              StiffRow* rows = scratch.lineStiff.data() + slice / 4;
                              if (G == W) {
@@ -461,11 +463,11 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                                for (std::size_t g = 0; consecutive && g + 1 < W; ++g) {
                                  consecutive = ids[g + 1] == ids[g] + 1 && lines.besideNext[ids[g]];
                                }
-                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                                     rows, consecutive);
+                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, tensionSum, restart, n, stiffness,
+                                                     alpha, rows, consecutive);
                              } else {
-                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, tensionSum, n, stiffness, alpha,
-                                                     rows, false);
+                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, tensionSum, restart, n, stiffness,
+                                                     alpha, rows, false);
                              }
                            });
               };
@@ -481,9 +483,9 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                                              const auto& lambda, const auto& offset, std::size_t n) {
                             std::array<float*, G> tensionSum{};
                             for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
-                              tensionSum[g] = lines.tensionSum.data() + offset[g];
+                              tensionSum[g] = lines.tension.data() + offset[g];
                             }
-                            solveLines<G>(s, p, rest, lambda, tensionSum, n, stiffness, alpha,
+                            solveLines<G>(s, p, rest, lambda, tensionSum, restart, n, stiffness, alpha,
                                           scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
                                           scratch.lineSolution.data() + slice);
                           });
@@ -491,6 +493,7 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
           },
           grain);
     }
+    if (geometricStiffness) lines.fresh = false;
   }
 }
 

@@ -30,10 +30,11 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads);
 // One Newton step of every line's projection from where its particles are now: the rows, then the
 // columns. `stiffness` scales each correction (position model); with `xpbd`, alphaTilde =
 // compliance / h^2 enters the system and the lines' lambdas accumulate. With `geometricStiffness`
-// the step adds its multipliers to tensionSum, and with `full` too it is the full Newton step, the
-// links' geometric stiffness from the tension they carried over the last substep
-// (scratch.lines[f].tension) included; else the tridiagonal (Gauss-Newton) one. The lines of a
-// family are independent: they are shared among the workers.
+// the step adds its multipliers to the tension (scratch.lines[f].tension; the substep's first step
+// starts it from them), and with `full` too it is the full Newton step, the links' geometric
+// stiffness from that tension as the step found it included (at the substep's first step, the
+// last substep's); else the tridiagonal (Gauss-Newton) one. The lines of a family are
+// independent: they are shared among the workers.
 void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
           bool full, Workers& workers);
 
@@ -59,8 +60,8 @@ int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
           Workers& workers, Real* looseLambda, const Extra& extra = {},
           const std::function<void()>& afterStep = nullptr);
 
-// At the start of a substep with geometric stiffness: the multipliers the last substep's solves
-// added up become the tension this one's use, and the sums start again from zero.
+// At the start of a substep with geometric stiffness: the tension the last substep's steps added
+// up is what the first step uses, and that step starts the sum again.
 void beginSubstep(SolverScratch& scratch);
 
 }  // namespace drape::sim::lines

@@ -355,7 +355,7 @@ MemoryUse World::memoryUse() const {
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
       m.lines += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda) + bytes(f.tension) +
-                 bytes(f.tensionSum) + bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
+                 bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
     }
   }
   for (const std::vector<Vec3>& good : lastGood_) m.guard += bytes(good);

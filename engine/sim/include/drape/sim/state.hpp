@@ -77,10 +77,12 @@ struct SolverScratch {
     std::vector<ParticleIndex> particle;
     std::vector<RestReal> rest;  // m, link k joins particle[k] and particle[k + 1] (unused at a line's end)
     std::vector<Real> lambda;    // XPBD: multiplier of link k, reset each substep
-    // solver.geometricStiffness: the sum of link k's multipliers over the last substep (its
-    // tension times h^2, negative when pulled), and over this one so far. Single precision: they
-    // only scale the geometric stiffness, and choose which lines take the full step.
-    std::vector<float> tension, tensionSum;
+    // solver.geometricStiffness: the sum of link k's multipliers (its tension times h^2, negative
+    // when pulled) over this substep's steps so far, or before its first, over the last substep's.
+    // The first step reads it and starts it again (fresh). Single precision: it only scales the
+    // geometric stiffness, and chooses which lines take the full step.
+    std::vector<float> tension;
+    bool fresh = true;
     // Per line: 1 if it takes the full Newton step this substep; the lines in the order they are
     // solved (the taut ones first, tautCount of them). Worked out at the substep's first full step:
     // ordered is cleared by lines::beginSubstep and build, and must be by whatever else writes
