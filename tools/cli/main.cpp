@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
   benchCommand
       ->add_option("--extra-line-steps", benchArguments.extraLineSteps,
                    "Drape's hang2 sweep: up to this many more line steps where an edge is still over 4 % "
-                   "(extraLineSteps; default 2)")
+                   "(extraLineSteps; default 4)")
       ->check(CLI::Range(0, 100));
   benchCommand->add_flag("--quick", benchArguments.quick,
                          "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps (each unless given)");

@@ -19,7 +19,7 @@ struct Hang2Solver {
   bool tethers = true;
   bool geometricStiffness = true;
   bool tethersBetweenSteps = false;
-  int extraLineSteps = 2;
+  int extraLineSteps = 4;
   double stretchTolerance = 0.04;
 };
 
