@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
 #include <glm/geometric.hpp>
 
 #include "drape/sim/cloth.hpp"
@@ -30,6 +34,17 @@ TEST(Lattice, RestLengthsAreTheSpacing) {
     EXPECT_FLOAT_EQ(c.restLength, static_cast<float>(std::hypot(0.25, 0.2)));
   for (const DistanceConstraint& c : rest.of(ConstraintKind::bend))
     EXPECT_FLOAT_EQ(c.restLength, alongX(c) ? 0.5f : 0.4f);
+}
+
+TEST(Lattice, RestLengthsSinglePrecisionCannotHoldAreRefused) {
+  EXPECT_EQ(toRestLength(0.0), 0.0f);
+  EXPECT_EQ(toRestLength(0.25), 0.25f);
+  for (const Real bad : {-1.0, 1e39, 1e-50, std::numeric_limits<Real>::infinity(), std::nan("")}) {
+    EXPECT_THROW(toRestLength(bad), std::invalid_argument) << bad;
+  }
+  // A lattice too large or too fine for them is refused, not built with infinite or zero lengths.
+  EXPECT_THROW(buildLattice({3, 3, 1e39, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
+  EXPECT_THROW(buildLattice({3, 3, 1e-100, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
 }
 
 TEST(Lattice, IndexIsRowMajorAndPlanesPointTheRightWay) {

@@ -245,6 +245,26 @@ TEST(Tearing, AChainBreaksAtItsMostStretchedLink) {
   EXPECT_EQ(world.cloths()[0].rest.of(ConstraintKind::stretch).size(), 4u);
 }
 
+TEST(Tearing, AChainHeldStretchedLosesOneLink) {
+  // Five links pinned 1.6 times their length apart: the sweeps share the stretch evenly, so several
+  // links pass 1.5 in the same step. One of them breaks, and the two pieces hang free of each other.
+  WorldSettings settings;
+  settings.gravity = Vec3{0.0};
+  settings.tearing = {true, 1.5};
+  settings.cloths.push_back(test::chainCloth(6, 1, 1.0, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz, {1.0, 0.0}));
+  settings.cloths[0].pins = {{0, 0, std::nullopt}, {5, 0, Vec3{1.6, 0.0, 0.0}}};
+  World world(settings);
+  int step = 0;
+  while (world.cloths()[0].pieceCount == 1 && step < 60) {
+    ++step;
+    world.step();
+  }
+  EXPECT_EQ(world.cloths()[0].pieceCount, 2u) << "step " << step;
+  EXPECT_EQ(world.cloths()[0].rest.of(ConstraintKind::stretch).size(), 4u);
+  world.run(30);
+  EXPECT_EQ(world.cloths()[0].pieceCount, 2u);  // and no more
+}
+
 TEST(Cutting, ASwipeAcrossTheSheetMakesTwoPiecesThatMoveApart) {
   World world(flatSheet(21));
   const std::uint64_t version = world.topologyVersion();

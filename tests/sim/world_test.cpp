@@ -145,6 +145,32 @@ TEST(Guard, PutsBackEveryPositionAsItWasBeforeTheBadStepBitForBitAtRest) {
   }
 }
 
+TEST(Guard, CopiesWhereAStageAfterIntegrationWritesThePreviousPositions) {
+  // One substep, but constraint damping (which changes x_prev) or two cloths with colliders and
+  // friction (which do not): the guard copies only for the first, and puts every cloth back.
+  WorldSettings damped = test::hangingSheet(20, 2, 1);
+  damped.cloths[0].material(ConstraintKind::stretch).damping = 0.2;
+  WorldSettings two = test::hangingSheet(20, 2, 1);
+  two.cloths.push_back(two.cloths[0]);
+  two.cloths[1].lattice.origin += Vec3{2.0, 0.0, 0.0};
+  two.colliders.push_back(ColliderSettings{});  // the ground plane
+  for (const auto& [settings, copies] : {std::pair{damped, true}, std::pair{two, false}}) {
+    World world(settings);
+    ASSERT_EQ(world.hasStage(Stage::dampConstraints), copies);
+    world.run(10);
+    std::vector<Cloth> cloths = world.cloths();
+    cloths.back().state.previousPosition.back() -= Vec3{0.0, 0.0, 1e6 * kRunawayDistance};
+    world.restoreCloths(cloths);
+    const std::vector<Cloth> before = world.cloths();
+    ASSERT_EQ(world.step(), StepStatus::diverged);
+    EXPECT_EQ(world.memoryUse().guard > 0, copies);
+    for (std::size_t c = 0; c < before.size(); ++c) {
+      EXPECT_EQ(world.cloths()[c].state.position, before[c].state.position) << "cloth " << c;
+      EXPECT_EQ(world.cloths()[c].state.previousPosition, before[c].state.position) << "cloth " << c;
+    }
+  }
+}
+
 TEST(Guard, PutsTheForceModelBackAtRest) {
   // A stiff spring under explicit Euler with a large step (as above): after the bad step, the
   // positions before it with no velocity.

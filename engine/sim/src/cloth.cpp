@@ -1,6 +1,7 @@
 #include "drape/sim/cloth.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -27,10 +28,19 @@ std::string_view name(LatticePlane plane) {
   return "?";
 }
 
+RestReal toRestLength(Real length) {
+  if (!(length >= 0.0 && length <= static_cast<Real>(std::numeric_limits<RestReal>::max()))) {
+    throw std::invalid_argument("a rest length must be a finite number of metres, at most 3.4e38");
+  }
+  const auto rest = static_cast<RestReal>(length);
+  if (length > 0.0 && rest == 0.0f) throw std::invalid_argument("a rest length must be at least 1.2e-38 m");
+  return rest;
+}
+
 namespace {
 
 void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
-  const auto restLength = static_cast<RestReal>(glm::length(rest.restPositions[b] - rest.restPositions[a]));
+  const RestReal restLength = toRestLength(glm::length(rest.restPositions[b] - rest.restPositions[a]));
   rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
 }
 

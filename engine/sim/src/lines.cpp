@@ -105,7 +105,8 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
 // stiffness included: with dx the particles' moves and l the links' multipliers,
 //   K dx - J^T l = 0,   J dx + alpha~ l = -(C + alpha~ lambda),
 //   K = M + sum_k G_k (on link k's two particles: [G, -G; -G, G]), G_k = g_k (I - n_k n_k^T),
-// g_k = the link's tension (times h^2, from the last substep) over its length (Tournier et al.
+// g_k = the link's tension (times h^2: the substep's multipliers so far, at its first step the last
+// substep's) over its length (Tournier et al.
 // 2015, Andrews et al. 2017). Without G this is solveLines' tridiagonal system; with it a
 // particle's sideways move drags its neighbours, as a taut string's does. The unknowns are
 // eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
@@ -406,7 +407,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     // The lines taut enough to need the full step (needsFullStep) are solved first, then the
     // others, each share taken by the workers in blocks: a full step costs about twice a
     // tridiagonal one, and the taut lines bunch together (near the pins).
-    // The tension is the last substep's: the flags and the order hold for the whole substep.
+    // The flags come from the tension at the substep's first full step (the last substep's) and
+    // hold for the whole substep.
     if (fullStep && !lines.ordered) {
       lines.taut.resize(count);
       lines.order.resize(count);

@@ -136,7 +136,7 @@ void scatterConsecutiveWide(const SolverScratch::StiffRows* rows, std::size_t n,
 #else
 // Not built for AVX (not an x86 machine): never called, as the CPU check says no.
 void gatherConsecutiveWide(SolverScratch::StiffRows*, std::size_t, const double*, const double*, const double*,
-                           const std::uint32_t*, const double* const*, const double* const*, const float* const*,
+                           const std::uint32_t*, const float* const*, const double* const*, const float* const*,
                            const double*, double) {}
 void scatterConsecutiveWide(const SolverScratch::StiffRows*, std::size_t, double*, const std::uint32_t*, double) {}
 #endif

@@ -1595,7 +1595,7 @@ OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selec
     return std::binary_search(sortedTriangles.begin(), sortedTriangles.end(), s);
   };
   const auto add = [&](ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
-    const auto restLength = static_cast<RestReal>(glm::length(rest.restPositions[b] - rest.restPositions[a]));
+    const RestReal restLength = toRestLength(glm::length(rest.restPositions[b] - rest.restPositions[a]));
     // Coincident particles cannot survive the collapses; should they, a constraint without a direction is worse
     // than none.
     if (restLength > 0.0) rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});

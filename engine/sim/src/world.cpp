@@ -222,7 +222,7 @@ void World::buildTethers(std::size_t c) {
     for (const std::size_t p : pins) {
       if (cloth.piece[i] != cloth.piece[p]) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
-      const auto length = static_cast<RestReal>(glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]));
+      const RestReal length = toRestLength(glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]));
       tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
     }
   }
@@ -533,6 +533,7 @@ StepStatus World::step() {
         case Stage::verletIntegrate:
         case Stage::projectConstraints:
         case Stage::collide:
+        case Stage::friction:
         case Stage::guard:
         case Stage::tear: break;
         default: return false;
@@ -591,7 +592,7 @@ StepStatus World::step() {
       }
       std::fill(s.velocity.begin(), s.velocity.end(), Vec3{0.0});
     }
-    for (Collider& collider : colliders_) collider.setTime(time());  // back where the good state saw them
+    for (Collider& collider : colliders_) collider.setTime(time());  // back where the last good positions saw them
     return StepStatus::diverged;
   }
   for (Finger& finger : fingers_) finger.position = finger.target;

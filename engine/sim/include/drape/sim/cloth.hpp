@@ -30,6 +30,10 @@ struct DistanceConstraint {
   RestReal restLength;  // m
 };
 
+// A rest length as the engine keeps it (RestReal). Throws std::invalid_argument where `length` is
+// not a finite non-negative number that single precision holds, or is positive but rounds to 0.
+RestReal toRestLength(Real length);
+
 // Which world plane the lattice is laid out in at rest.
 enum class LatticePlane : std::uint8_t {
   xz,  // lying flat: columns along +x, rows along +z, at height origin.y

@@ -41,7 +41,7 @@ struct SolverScratch {
   std::array<std::vector<Real>, kConstraintKindCount> lambda;
   // Tethers (solver.tethers): each free particle may be no farther from each pin of its piece than
   // at rest. Kept in runs of consecutive particles tied to the same pins: a run lists its pins once
-  // and each of its particles only its lengths (on hang2 that is 16 bytes a particle, not 32).
+  // and each of its particles only its lengths (on hang2 that is 8 bytes a particle, not 24).
   struct Tethers {
     struct Tether {  // one, as they are built and filtered (list, assign)
       ParticleIndex particle;
