@@ -254,7 +254,8 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       return toLoad;
     }
     changed |= sliderReal("dt (s)", tuned.solver.dt, 0.001, 0.05, "%.4f", ImGuiSliderFlags_Logarithmic);
-    changed |= ImGui::SliderInt("substeps", &tuned.solver.substeps, 1, 32);
+    // The force model may have taken hundreds to stay stable (scene::withModel): the slider reaches them.
+    changed |= ImGui::SliderInt("substeps", &tuned.solver.substeps, 1, std::max(32, world.settings().solver.substeps));
     changed |= ImGui::SliderInt("iterations", &tuned.solver.iterations, 0, 100);
     changed |= sliderReal("damping (1/s)", tuned.solver.damping, 0.0, 5.0);
     if (tuned.solver.model == sim::Model::position) {

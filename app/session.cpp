@@ -123,7 +123,9 @@ std::optional<std::string> Session::setModel(sim::Model model, sim::Integrator i
     return status;
   }
   status = "model: " + std::string(sim::name(model)) +
-           (model == sim::Model::force ? " (" + std::string(sim::name(integrator)) + ")" : std::string()) +
+           (model == sim::Model::force ? " (" + std::string(sim::name(integrator)) + ", " +
+                                             std::to_string(world_->settings().solver.substeps) + " substeps)"
+                                       : std::string()) +
            ", from the start";
   return std::nullopt;
 }

@@ -372,5 +372,30 @@ TEST(SceneReader, ExtraLineStepsNeedLinesAndAToleranceInRange) {
   EXPECT_EQ(switched.document.find("stretchTolerance"), std::string::npos);
 }
 
+TEST(Scene, SwitchingToTheForceModelTakesTheSubstepsItsSpringsNeed) {
+  // 12 particles of 0.83 g on the force model's 2000 N/m springs: a few hundred substeps of 1/60 s.
+  json light = minimal();
+  applyOverride(light, "cloths.0.mass=0.01");
+  const Scene scene = parseScene(light, "s.json");
+  for (const sim::Integrator integrator : {sim::Integrator::symplecticEuler, sim::Integrator::rk4}) {
+    const Scene switched = withModel(scene, sim::Model::force, integrator);
+    const sim::SolverSettings& solver = switched.world.solver;
+    sim::World world(switched.world);
+    const double longest = 0.9 * world.stableForceSubstep();
+    EXPECT_LE(solver.dt / solver.substeps, longest) << sim::name(integrator);        // enough ...
+    EXPECT_GT(solver.dt / (solver.substeps - 1), longest) << sim::name(integrator);  // ... and no more
+    EXPECT_NE(switched.document.find("\"substeps\":" + std::to_string(solver.substeps)), std::string::npos);
+    EXPECT_EQ(world.run(60), sim::StepStatus::ok) << sim::name(integrator);
+    // At the scene's own substeps the same cloth blows up.
+    sim::WorldSettings few = switched.world;
+    few.solver.substeps = scene.world.solver.substeps;
+    sim::World unstable(few);
+    EXPECT_EQ(unstable.run(60), sim::StepStatus::diverged) << sim::name(integrator);
+  }
+  // The position model keeps the scene's substeps.
+  EXPECT_EQ(withModel(scene, sim::Model::position, sim::Integrator::verlet).world.solver.substeps,
+            scene.world.solver.substeps);
+}
+
 }  // namespace
 }  // namespace drape::scene

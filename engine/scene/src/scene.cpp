@@ -1,5 +1,6 @@
 #include "drape/scene/scene.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -10,6 +11,7 @@
 
 #include "colliders.hpp"
 #include "drape/scene/error.hpp"
+#include "drape/sim/world.hpp"
 #include "json_reader.hpp"
 
 namespace drape::scene {
@@ -321,12 +323,24 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
   }
   solver.model = model;
   solver.integrator = integrator;
+  if (model == Model::force) {
+    try {
+      const double longest = 0.9 * sim::World(changed.world).stableForceSubstep();
+      if (std::isfinite(longest) && longest > 0.0) {
+        const double needed = std::min(std::ceil(solver.dt / longest), static_cast<double>(sim::kMaxSubsteps));
+        solver.substeps = std::max(solver.substeps, static_cast<int>(needed));
+      }
+    } catch (const std::invalid_argument&) {
+      // Settings no world takes: whoever builds one says why.
+    }
+  }
   // The document (what a snapshot keeps) says the same: the model, and the materials left to default.
   json document = json::parse(changed.document, nullptr, false);
   if (document.is_object()) {
     json& solverDocument = document["solver"];
     solverDocument["model"] = std::string(sim::name(model));
     solverDocument["integrator"] = std::string(sim::name(integrator));
+    solverDocument["substeps"] = solver.substeps;
     if (model == Model::force) {
       solverDocument.erase("xpbd");
       solverDocument.erase("tethers");

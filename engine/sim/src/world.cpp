@@ -391,6 +391,32 @@ bool World::hasStage(Stage stage) const {
   return false;
 }
 
+Real World::stableForceSubstep() const {
+  if (settings_.solver.model != Model::force) return std::numeric_limits<Real>::infinity();
+  Real fastest = 0.0;  // omega + decay rate, 1/s
+  for (const Cloth& cloth : cloths_) {
+    const ParticleState& s = cloth.state;
+    std::vector<Real> stiffness(s.position.size(), 0.0), damping(s.position.size(), 0.0);
+    for (ConstraintKind kind : kConstraintKinds) {
+      const KindMaterial& material = cloth.settings.material(kind);
+      for (const DistanceConstraint& c : cloth.rest.of(kind)) {
+        for (const ParticleIndex p : {c.a, c.b}) {
+          stiffness[p] += material.stiffness;
+          damping[p] += material.damping;
+        }
+      }
+    }
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+      if (s.inverseMass[i] == 0.0) continue;
+      fastest =
+          std::max(fastest, std::sqrt(2.0 * stiffness[i] * s.inverseMass[i]) + 2.0 * damping[i] * s.inverseMass[i]);
+    }
+  }
+  if (fastest == 0.0) return std::numeric_limits<Real>::infinity();
+  const Real interval = settings_.solver.integrator == Integrator::rk4 ? 2.78 : 2.0;
+  return interval / (fastest + settings_.air.drag);
+}
+
 Vec3 World::velocity(int cloth, ParticleIndex particle) const {
   const ParticleState& s = cloths_.at(static_cast<std::size_t>(cloth)).state;
   if (!s.velocity.empty()) return s.velocity.at(particle);

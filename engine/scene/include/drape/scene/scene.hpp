@@ -43,7 +43,10 @@ sim::ClothSettings drawnClothTemplate(const Scene& scene);
 
 // The scene with another model or integrator. Materials mean different things in the two models
 // (a 0..1 fraction, or N/m), so when the model changes every cloth takes the new model's default
-// materials, and XPBD and tethers (position model only) are switched off for the force model.
+// materials, and XPBD and tethers (position model only) are switched off for the force model. The
+// force model also takes as many substeps as its integrator needs to stay stable on the cloths'
+// springs (sim::World::stableForceSubstep, with a tenth to spare; at most sim::kMaxSubsteps), if
+// that is more than the scene has: a light cloth's springs can need hundreds.
 Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator);
 
 // Finds a scene by path, or by name in the shipped scenes folder (`hang` -> assets/scenes/hang.json).

@@ -118,6 +118,13 @@ class World {
   // Velocity of a particle, m/s: stored in the force model, (x - x_prev) / h in the position model.
   Vec3 velocity(int cloth, ParticleIndex particle) const;
 
+  // The force model: the longest substep (s) its integrator is stable at on these cloths' springs,
+  // by Gershgorin's bound on the fastest mode: omega^2 <= 2 (sum of k) / m and a decay rate <= 2 (sum
+  // of kd) / m + drag, sums over each free particle's springs; stable while h (omega + rate) stays
+  // within the integrator's interval (2.78 for RK4, else 2; explicit Euler and midpoint are never
+  // quite stable undamped). Infinity in the position model or without springs.
+  Real stableForceSubstep() const;
+
   // Fingers. Any number may be down at once, each under the caller's id.
   // press: every particle within `radius` of `point` on the piece of the particle nearest to it
   // sticks to the finger, except particles another finger already holds (the first finger keeps
