@@ -32,7 +32,7 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
 template <std::size_t G>
 void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
                 const std::array<const RestReal*, G>& rest, const std::array<Real*, G>& lambda,
-                const std::array<float*, G>& tensionSum, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
+                const std::array<float*, G>& summed, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
                 Vec3* normal, Real* upper, Real* solution) {
   const std::size_t links = n - 1;
   Vec3* x = s.position.data();
@@ -88,7 +88,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
       const std::size_t at = k * G + g;
       const Real dl = solution[at] * stiffness;
       if (lambda[g]) lambda[g][k] += dl;
-      if (tensionSum[g]) tensionSum[g][k] = static_cast<float>((restart ? 0.0f : tensionSum[g][k]) + dl);
+      if (summed[g]) summed[g][k] = static_cast<float>((restart ? 0.0f : summed[g][k]) + dl);
       const Vec3 push = normal[at] * dl;
       x[p[g][k]] -= push * w[p[g][k]];
       x[p[g][k + 1]] += push * w[p[g][k + 1]];
@@ -118,7 +118,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
 template <std::size_t W, std::size_t FixedG>
 void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const ParticleIndex*, W>& p,
                      const std::array<const RestReal*, W>& rest, const std::array<Real*, W>& lambda,
-                     const std::array<const float*, W>& tension, const std::array<float*, W>& tensionSum, bool restart,
+                     const std::array<const float*, W>& tension, const std::array<float*, W>& summed, bool restart,
                      std::size_t n, Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
   static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
   // Eight lines whose particles at each k are consecutive (p[g][k] = p[0][k] + g) are gathered and
@@ -205,7 +205,7 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;
-      tensionSum[g][j - 1] = static_cast<float>((restart ? 0.0f : tensionSum[g][j - 1]) + multiplier);
+      summed[g][j - 1] = static_cast<float>((restart ? 0.0f : summed[g][j - 1]) + multiplier);
     }
   }
 }
@@ -454,10 +454,10 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                              // The tension is read and summed in the same array: a line's gather
                              // reads its links' before its scatter adds to them.
                              std::array<const float*, W> tension{};
-                             std::array<float*, W> tensionSum{};
+                             std::array<float*, W> summed{};
                              for (std::size_t g = 0; g < G; ++g) {
                                tension[g] = lines.tension.data() + offset[g];
-                               tensionSum[g] = lines.tension.data() + offset[g];
+                               summed[g] = lines.tension.data() + offset[g];
                              }
                              StiffRow* rows = scratch.lineStiff.data() + slice / 4;
                              if (G == W) {
@@ -465,10 +465,10 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                                for (std::size_t g = 0; consecutive && g + 1 < W; ++g) {
                                  consecutive = ids[g + 1] == ids[g] + 1 && lines.besideNext[ids[g]];
                                }
-                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, tensionSum, restart, n, stiffness,
+                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, summed, restart, n, stiffness,
                                                      alpha, rows, consecutive);
                              } else {
-                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, tensionSum, restart, n, stiffness,
+                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, summed, restart, n, stiffness,
                                                      alpha, rows, false);
                              }
                            });
@@ -483,11 +483,11 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
               inGroups<4>(lines, line, last - first, xpbd,
                           [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
                                              const auto& lambda, const auto& offset, std::size_t n) {
-                            std::array<float*, G> tensionSum{};
+                            std::array<float*, G> summed{};
                             for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
-                              tensionSum[g] = lines.tension.data() + offset[g];
+                              summed[g] = lines.tension.data() + offset[g];
                             }
-                            solveLines<G>(s, p, rest, lambda, tensionSum, restart, n, stiffness, alpha,
+                            solveLines<G>(s, p, rest, lambda, summed, restart, n, stiffness, alpha,
                                           scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
                                           scratch.lineSolution.data() + slice);
                           });
