@@ -1,7 +1,7 @@
 #include "drape/scene/snapshot.hpp"
 
 #include <cmath>
-#include <limits>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -118,16 +118,17 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
                                                 return glm::uvec3{*a, *b, *d};
                                               });
     for (sim::ConstraintKind kind : sim::kConstraintKinds) {
-      cloth.rest.constraints[static_cast<std::size_t>(kind)] =
-          tuples<sim::DistanceConstraint>(reader, sim::name(kind), 3, "[a, b, rest length], " + particle,
-                                          [&](const json& k) -> std::optional<sim::DistanceConstraint> {
-                                            const auto a = index(k[0]), b = index(k[1]);
-                                            const double rest = k[2].get<double>();
-                                            if (!a || !b || *a == *b || !std::isfinite(rest) || rest < 0.0 ||
-                                                rest > std::numeric_limits<sim::RestReal>::max())
-                                              return std::nullopt;
-                                            return sim::DistanceConstraint{*a, *b, static_cast<sim::RestReal>(rest)};
-                                          });
+      cloth.rest.constraints[static_cast<std::size_t>(kind)] = tuples<sim::DistanceConstraint>(
+          reader, sim::name(kind), 3, "[a, b, rest length], " + particle,
+          [&](const json& k) -> std::optional<sim::DistanceConstraint> {
+            const auto a = index(k[0]), b = index(k[1]);
+            if (!a || !b || *a == *b) return std::nullopt;
+            try {
+              return sim::DistanceConstraint{*a, *b, sim::toRestLength(k[2].get<double>())};
+            } catch (const std::invalid_argument&) {
+              return std::nullopt;  // not one a float holds
+            }
+          });
     }
     sim::ParticleState& s = cloth.state;
     s.position = tuples<sim::Vec3>(reader, "positions", 3, "[x, y, z], finite", vec3);

@@ -118,8 +118,8 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
 template <std::size_t W, std::size_t FixedG>
 void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const ParticleIndex*, W>& p,
                      const std::array<const RestReal*, W>& rest, const std::array<Real*, W>& lambda,
-                     const std::array<const float*, W>& tension, const std::array<float*, W>& summed, bool restart,
-                     std::size_t n, Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
+                     const std::array<float*, W>& tension, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
+                     SolverScratch::StiffRows* rows, bool consecutive) {
   static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
   // Eight lines whose particles at each k are consecutive (p[g][k] = p[0][k] + g) are gathered and
   // scattered eight particles at a time (lines_wide.cpp): the same bits as below.
@@ -205,7 +205,7 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;
-      summed[g][j - 1] = static_cast<float>((restart ? 0.0f : summed[g][j - 1]) + multiplier);
+      tension[g][j - 1] = static_cast<float>((restart ? 0.0f : tension[g][j - 1]) + multiplier);
     }
   }
 }
@@ -453,23 +453,19 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                                std::size_t n, const std::uint32_t* ids) {
                              // The tension is read and summed in the same array: a line's gather
                              // reads its links' before its scatter adds to them.
-                             std::array<const float*, W> tension{};
-                             std::array<float*, W> summed{};
-                             for (std::size_t g = 0; g < G; ++g) {
-                               tension[g] = lines.tension.data() + offset[g];
-                               summed[g] = lines.tension.data() + offset[g];
-                             }
+                             std::array<float*, W> tension{};
+                             for (std::size_t g = 0; g < G; ++g) tension[g] = lines.tension.data() + offset[g];
                              StiffRow* rows = scratch.lineStiff.data() + slice / 4;
                              if (G == W) {
                                bool consecutive = true;
                                for (std::size_t g = 0; consecutive && g + 1 < W; ++g) {
                                  consecutive = ids[g + 1] == ids[g] + 1 && lines.besideNext[ids[g]];
                                }
-                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, summed, restart, n, stiffness,
-                                                     alpha, rows, consecutive);
+                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, restart, n, stiffness, alpha, rows,
+                                                     consecutive);
                              } else {
-                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, summed, restart, n, stiffness,
-                                                     alpha, rows, false);
+                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, restart, n, stiffness, alpha, rows,
+                                                     false);
                              }
                            });
               };

@@ -275,6 +275,29 @@ void World::buildPipeline() {
   }
   add(Stage::guard, false);
   if (settings_.tearing.enabled && !cloths_.empty()) add(Stage::tear, false);
+  // The guard goes back to the positions before the step, at rest: no copy where one substep of the
+  // position model leaves them in the previous positions (its integration sets x_prev = x and no
+  // stage after it writes x_prev); else a copy, made by that integration as it reads them where
+  // it is the first stage to change anything (no finger moves particles before it).
+  const auto onlyPositionsAfterIntegration = [&] {
+    for (const StageTiming& timing : profile_) {
+      switch (timing.stage) {
+        case Stage::windPressure:
+        case Stage::verletIntegrate:
+        case Stage::projectConstraints:
+        case Stage::collide:
+        case Stage::friction:
+        case Stage::guard:
+        case Stage::tear: break;
+        default: return false;
+      }
+    }
+    return true;
+  };
+  guardCopy_ = model != Model::position                                            ? GuardCopy::before
+               : settings_.solver.substeps == 1 && onlyPositionsAfterIntegration() ? GuardCopy::none
+               : anyHeld                                                           ? GuardCopy::before
+                                                                                   : GuardCopy::integration;
   if (model == Model::position) {
     // Wind pressure's per-particle accelerations exist exactly while its stage does (tuning can
     // switch it on or off): the integrator adds them whenever the array is there.
@@ -547,29 +570,7 @@ StepStatus World::step() {
   using Clock = std::chrono::steady_clock;
   if (divergence_) return StepStatus::diverged;
   if (!historyStarted_) startHistory();
-  // The guard goes back to the positions before the step, at rest: no copy where one substep of the
-  // position model leaves them in the previous positions (its integration sets x_prev = x and no
-  // stage after it writes x_prev); else a copy, made by that integration as it reads them where
-  // it is the first stage to change anything (no finger moves particles before it).
-  const bool position = settings_.solver.model == Model::position;
-  const auto onlyPositionsAfterIntegration = [&] {
-    for (const StageTiming& timing : profile_) {
-      switch (timing.stage) {
-        case Stage::windPressure:
-        case Stage::verletIntegrate:
-        case Stage::projectConstraints:
-        case Stage::collide:
-        case Stage::friction:
-        case Stage::guard:
-        case Stage::tear: break;
-        default: return false;
-      }
-    }
-    return true;
-  };
-  guardCopy_ = position && settings_.solver.substeps == 1 && onlyPositionsAfterIntegration() ? GuardCopy::none
-               : position && !hasStage(Stage::fingers)                                       ? GuardCopy::integration
-                                                                                             : GuardCopy::before;
+  // The positions before the step, for the guard (where its copy is made: buildPipeline).
   lastGood_.resize(cloths_.size());
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     std::vector<Vec3>& good = lastGood_[c];
