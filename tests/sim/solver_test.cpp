@@ -56,9 +56,9 @@ TEST(Lines, AChainIsOneLine) {
   SolverScratch scratch;
   lines::build(cloth, scratch, 1);
   ASSERT_EQ(scratch.lines[0].start.size(), 2u);  // one line along x
-  EXPECT_EQ(scratch.lines[0].particle.size(), 30u);
+  EXPECT_EQ(scratch.lines[0].slots(), 30u);
   EXPECT_TRUE(scratch.looseStretch.empty());
-  EXPECT_EQ(scratch.lines[1].particle.size(), 0u);
+  EXPECT_EQ(scratch.lines[1].slots(), 0u);
 }
 
 TEST(Lines, ALatticeIsRowsAndColumns) {
@@ -69,8 +69,55 @@ TEST(Lines, ALatticeIsRowsAndColumns) {
   lines::build(cloth, scratch, 1);
   EXPECT_EQ(scratch.lines[0].start.size(), 10u);  // 9 rows
   EXPECT_EQ(scratch.lines[1].start.size(), 10u);  // 9 columns
-  EXPECT_EQ(scratch.lines[0].particle.size() + scratch.lines[1].particle.size(), 2u * 81u);
+  EXPECT_EQ(scratch.lines[0].slots() + scratch.lines[1].slots(), 2u * 81u);
   EXPECT_TRUE(scratch.looseStretch.empty());
+}
+
+TEST(Lines, TheStretchConstraintsAreKeptInLineOrderWhateverOrderTheyCameIn) {
+  // The lines read their particles and rest lengths from the cloth's stretch constraints, which
+  // build puts in line order. A drawn cloth's irregular fill leaves some links loose; which depends
+  // on the order links are taken in, so build takes them in their particles' order: built again
+  // from any order (a snapshot's, or after the threads change), the lines come out the same.
+  WorldSettings settings = test::hangingSheet(4, 1, 1);
+  settings.cloths[0].outline = OutlineSpec{{{0.0, 0.0}, {0.9, 0.1}, {0.7, 0.8}, {0.2, 0.6}, {0.4, 0.35}}, 0.07, 1.0};
+  settings.cloths[0].pins.clear();
+  World world(settings);
+  Cloth cloth = world.cloths()[0];
+  SolverScratch scratch;
+  lines::build(cloth, scratch, 1);
+  const std::vector<DistanceConstraint> built = cloth.rest.of(ConstraintKind::stretch);
+  ASSERT_FALSE(scratch.looseStretch.empty());  // the fill is irregular enough to leave some loose
+  // Each line's link k runs from its particle k to k + 1, and the next link goes on from there.
+  for (const SolverScratch::LineFamily& family : scratch.lines) {
+    for (std::size_t l = 0; l + 1 < family.start.size(); ++l) {
+      const std::size_t first = family.firstLink(l), links = family.start[l + 1] - family.start[l] - 1;
+      for (std::size_t k = 1; k < links; ++k) ASSERT_EQ(built[first + k].a, built[first + k - 1].b);
+    }
+  }
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<DistanceConstraint>& stretch =
+        cloth.rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
+    std::shuffle(stretch.begin(), stretch.end(), random);
+    for (DistanceConstraint& c : stretch) {
+      if (random() % 2) std::swap(c.a, c.b);
+    }
+    SolverScratch again;
+    lines::build(cloth, again, 1);
+    const std::vector<DistanceConstraint>& rebuilt = cloth.rest.of(ConstraintKind::stretch);
+    ASSERT_EQ(rebuilt.size(), built.size());
+    // The lines' links point along their lines; a loose one keeps the way it was given.
+    const std::size_t loose = built.size() - scratch.looseStretch.size();
+    for (std::size_t k = 0; k < built.size(); ++k) {
+      const auto ends = [&](const DistanceConstraint& c) {
+        return k < loose ? std::pair{c.a, c.b} : std::pair{std::min(c.a, c.b), std::max(c.a, c.b)};
+      };
+      ASSERT_EQ(ends(rebuilt[k]), ends(built[k])) << "trial " << trial << ", constraint " << k;
+      ASSERT_EQ(rebuilt[k].restLength, built[k].restLength) << "trial " << trial << ", constraint " << k;
+    }
+    EXPECT_EQ(again.looseStretch, scratch.looseStretch);
+    for (std::size_t f = 0; f < 2; ++f) EXPECT_EQ(again.lines[f].start, scratch.lines[f].start);
+  }
 }
 
 TEST(Lines, AStraightStretchedChainIsExactInOneSolve) {
@@ -128,10 +175,11 @@ TEST(Lines, OnlyATautLineTakesTheFullNewtonStep) {
     SolverScratch scratch;
     lines::build(cloth, scratch, 1);
     SolverScratch::LineFamily& line = scratch.lines[0];
-    line.tension.resize(line.rest.size());
-    for (std::size_t k = 0; k + 1 < line.rest.size(); ++k) {
+    line.tension.resize(line.slots());
+    const DistanceConstraint* link = cloth.rest.of(ConstraintKind::stretch).data() + line.firstLink(0);
+    for (std::size_t k = 0; k + 1 < line.slots(); ++k) {
       line.tension[k] =
-          static_cast<float>(-ratio * scratch.fullStepRatio * line.rest[k] * cloth.state.mass[line.particle[k]]);
+          static_cast<float>(-ratio * scratch.fullStepRatio * link[k].restLength * cloth.state.mass[link[k].a]);
     }
     Workers workers(1);
     lines::solve(cloth, scratch, 1.0, false, 0.0, geometricStiffness, workers, nullptr);
@@ -167,7 +215,7 @@ TEST(Lines, TheStiffSolveGivesTheSameBitsEightLinesAtATimeAsFour) {
     scratch.fullStepRatio = 0.0;  // every line takes the full step
     std::uniform_real_distribution<float> pull(-2e-4f, 0.0f);
     for (SolverScratch::LineFamily& family : scratch.lines) {
-      family.tension.resize(family.rest.size());
+      family.tension.resize(family.slots());
       for (float& t : family.tension) t = pull(random);
     }
     Workers workers(1);
@@ -199,7 +247,7 @@ TEST(Lines, TheStiffSolveDoesNotDependOnHowMuchTheClothWeighs) {
     for (Real& w : cloth.state.inverseMass) w /= massScale;
     SolverScratch scratch;
     lines::build(cloth, scratch, 1);
-    scratch.lines[0].tension.assign(scratch.lines[0].rest.size(), static_cast<float>(-1e-3 * massScale));
+    scratch.lines[0].tension.assign(scratch.lines[0].slots(), static_cast<float>(-1e-3 * massScale));
     Workers workers(1);
     lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
     return cloth.state.position;
@@ -220,7 +268,7 @@ TEST(Lines, UnderTensionAStraightStretchedChainIsStillExactInOneSolve) {
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) cloth.state.position[i].x *= 1.3;
   SolverScratch scratch;
   lines::build(cloth, scratch, 1);
-  scratch.lines[0].tension.assign(scratch.lines[0].rest.size(), -1e-3f);  // pulled hard
+  scratch.lines[0].tension.assign(scratch.lines[0].slots(), -1e-3f);  // pulled hard
   Workers workers(1);
   lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
   EXPECT_LT(worstViolation(cloth), 1e-12);
@@ -238,12 +286,12 @@ TEST(Lines, TheTensionIsTheSumOfTheSubstepsMultipliersSoFar) {
   lines::build(cloth, scratch, 1);
   Workers workers(1);
   for (int substep = 0; substep < 2; ++substep) {
-    for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.rest.size(), 0.0);
+    for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.slots(), 0.0);
     lines::beginSubstep(scratch);
     lines::solve(cloth, scratch, 1.0, true, 1e-4, true, workers, nullptr);
     const SolverScratch::LineFamily& family = scratch.lines[0];
     Real largest = 0.0;
-    for (std::size_t k = 0; k + 1 < family.rest.size(); ++k) {
+    for (std::size_t k = 0; k + 1 < family.slots(); ++k) {
       EXPECT_NEAR(family.tension[k], family.lambda[k], 1e-6 * std::abs(family.lambda[k]) + 1e-12)
           << "substep " << substep << " link " << k;
       largest = std::max(largest, std::abs(family.lambda[k]));

@@ -25,13 +25,19 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   return i;
 }
 
+// A line's particles and links, read from the cloth's stretch constraints in line order (build):
+// link k joins particle k, its a, to particle k + 1, its b.
+struct Line {
+  const DistanceConstraint* link = nullptr;
+  ParticleIndex operator[](std::size_t k) const { return k == 0 ? link[0].a : link[k - 1].b; }
+};
+
 // Solves G lines of n particles each in place, interleaved: line g has particles p[g][0..n) and
-// links 0..n-2. Each line's arithmetic is the same whatever G is; interleaving only lets the core
+// links p[g].link[0..n-2]. Each line's arithmetic is the same whatever G is; interleaving only lets the core
 // overlap the lines' chains of divisions (Thomas' recurrence is serial within a line).
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
 template <std::size_t G>
-void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
-                const std::array<const RestReal*, G>& rest, const std::array<Real*, G>& lambda,
+void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array<Real*, G>& lambda,
                 const std::array<float*, G>& summed, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
                 Vec3* normal, Real* upper, Real* solution) {
   const std::size_t links = n - 1;
@@ -42,14 +48,15 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
   for (std::size_t k = 0; k < links; ++k) {
     for (std::size_t g = 0; g < G; ++g) {
       const std::size_t at = k * G + g;
-      const Vec3 d = x[p[g][k + 1]] - x[p[g][k]];
+      const DistanceConstraint& c = p[g].link[k];
+      const Vec3 d = x[c.b] - x[c.a];
       const Real length2 = glm::dot(d, d);
-      const Real diagonal = w[p[g][k]] + w[p[g][k + 1]] + alphaTilde;
+      const Real diagonal = w[c.a] + w[c.b] + alphaTilde;
       if (length2 > 1e-20 && diagonal > 0.0) {
         const Real length = std::sqrt(length2);
         normal[at] = d * (1.0 / length);
         upper[at] = diagonal;
-        solution[at] = -(length - rest[g][k]) - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0);
+        solution[at] = -(length - c.restLength) - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0);
       } else {
         normal[at] = Vec3{0.0};
         upper[at] = 1.0;
@@ -72,7 +79,7 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
       // singular; that link is then corrected as if alone.
       if (!(pivot > 1e-9 * diagonal)) pivot = diagonal;
       const Real inverse = 1.0 / pivot;
-      const Real coupling = k + 1 < links ? -w[p[g][k + 1]] * glm::dot(normal[at], normal[at + G]) : 0.0;
+      const Real coupling = k + 1 < links ? -w[p[g].link[k].b] * glm::dot(normal[at], normal[at + G]) : 0.0;
       previousCoupling[g] = coupling;
       upper[at] = coupling * inverse;
       solution[at] = (solution[at] - lower * previousSolution[g]) * inverse;
@@ -90,8 +97,9 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
       if (lambda[g]) lambda[g][k] += dl;
       if (summed[g]) summed[g][k] = static_cast<float>((restart ? 0.0f : summed[g][k]) + dl);
       const Vec3 push = normal[at] * dl;
-      x[p[g][k]] -= push * w[p[g][k]];
-      x[p[g][k + 1]] += push * w[p[g][k + 1]];
+      const DistanceConstraint& c = p[g].link[k];
+      x[c.a] -= push * w[c.a];
+      x[c.b] += push * w[c.b];
     }
   }
 }
@@ -116,10 +124,9 @@ void solveLines(ParticleState& s, const std::array<const ParticleIndex*, G>& p,
 // particle and no link), and the moves and multipliers scattered back.
 // (FixedG: the number of lines G when it is known at compile time, a full group; 0: given as count.)
 template <std::size_t W, std::size_t FixedG>
-void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const ParticleIndex*, W>& p,
-                     const std::array<const RestReal*, W>& rest, const std::array<Real*, W>& lambda,
-                     const std::array<float*, W>& tension, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
-                     SolverScratch::StiffRows* rows, bool consecutive) {
+void solveStiffLines(ParticleState& s, std::size_t count, const std::array<Line, W>& p,
+                     const std::array<Real*, W>& lambda, const std::array<float*, W>& tension, bool restart,
+                     std::size_t n, Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
   static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
   // Eight lines whose particles at each k are consecutive (p[g][k] = p[0][k] + g) are gathered and
   // scattered eight particles at a time (lines_wide.cpp): the same bits as below.
@@ -149,8 +156,10 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
   const bool wide = kWide && consecutive;
   static_assert(sizeof(Vec3) == 3 * sizeof(double), "the wide gather reads positions as x, y, z doubles");
   if (wide) {
-    gatherConsecutiveWide(rows, n, reinterpret_cast<const double*>(x), w, mass, p[0], rest.data(), lambda.data(),
-                          tension.data(), perUnitMass.data(), alphaTilde);
+    std::array<const DistanceConstraint*, W> lineLinks{};
+    for (std::size_t g = 0; g < W; ++g) lineLinks[g] = p[g].link;
+    gatherConsecutiveWide(rows, n, reinterpret_cast<const double*>(x), w, mass, p[0].link, lineLinks.data(),
+                          lambda.data(), tension.data(), perUnitMass.data(), alphaTilde);
   } else {
     std::array<Vec3, W> from;
     std::array<Real, W> fromW;
@@ -161,29 +170,30 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
     for (std::size_t k = 0; k < n; ++k) {
       Row& r = rows[k];
       for (std::size_t g = 0; g < G; ++g) {
-        r.mass[g] = static_cast<float>(mass[p[g][k]] * perUnitMass[g]);
-        r.moves[g] = fromW[g] > 0.0 ? 1.0f : 0.0f;
+        r.v[0][g] = static_cast<float>(mass[p[g][k]] * perUnitMass[g]);  // (StiffRows: what v holds before)
+        r.v[1][g] = fromW[g] > 0.0 ? 1.0f : 0.0f;
         if (k == links) {
-          r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
+          r.nx[g] = r.ny[g] = r.nz[g] = r.yl[g] = r.g[g] = r.schur[g] = 0.0f;
           continue;
         }
-        const Vec3 to = x[p[g][k + 1]];
-        const Real toW = w[p[g][k + 1]];
+        const DistanceConstraint& c = p[g].link[k];
+        const Vec3 to = x[c.b];
+        const Real toW = w[c.b];
         const Vec3 d = to - from[g];
         r.nx[g] = static_cast<float>(d.x);
         r.ny[g] = static_cast<float>(d.y);
         r.nz[g] = static_cast<float>(d.z);
         // C + alpha~ lambda = length - (rest - alpha~ lambda)
-        r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
+        r.yl[g] = static_cast<float>(c.restLength - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
         // Pulled links only: a pushed one would make K indefinite.
         r.g[g] = static_cast<float>(std::max(-static_cast<Real>(tension[g][k]), 0.0) * perUnitMass[g]);
-        r.live[g] = fromW[g] + toW + alphaTilde > 0.0 ? 1.0f : 0.0f;
+        r.schur[g] = fromW[g] + toW + alphaTilde > 0.0 ? 1.0f : 0.0f;
         from[g] = to;
         fromW[g] = toW;
       }
       for (std::size_t g = G; g < W; ++g) {
-        r.mass[g] = 1.0f;
-        r.moves[g] = r.nx[g] = r.ny[g] = r.nz[g] = r.rhs[g] = r.g[g] = r.live[g] = 0.0f;
+        r.v[0][g] = 1.0f;
+        r.v[1][g] = r.nx[g] = r.ny[g] = r.nz[g] = r.yl[g] = r.g[g] = r.schur[g] = 0.0f;
       }
     }
   }
@@ -197,11 +207,11 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
   // (its move is 0 too, but it must stay put even if something upstream went non-finite).
   std::array<Real, W> multiplierScale{};
   for (std::size_t g = 0; g < G; ++g) multiplierScale[g] = unitMass[g] * stiffness;
-  if (wide) scatterConsecutiveWide(rows, n, reinterpret_cast<double*>(x), p[0], stiffness);
+  if (wide) scatterConsecutiveWide(rows, n, reinterpret_cast<double*>(x), w, p[0].link, stiffness);
   for (std::size_t j = 0; j < n; ++j) {
     const Row& r = rows[j];
     for (std::size_t g = 0; g < G; ++g) {
-      if (!wide && r.moves[g] != 0.0f) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
+      if (!wide && w[p[g][j]] > 0.0) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;
@@ -210,40 +220,38 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<const
   }
 }
 
-// Where lines line[0, G) of a family start, and their particles, rest lengths and multipliers
-// (null without XPBD), in arrays of N.
+// Where lines line[0, G) of a family start (their slots), their links (in `stretch`, the cloth's
+// stretch constraints) and multipliers (null without XPBD), in arrays of N.
 template <std::size_t N>
 struct LineData {
-  std::array<const ParticleIndex*, N> p{};
-  std::array<const RestReal*, N> rest{};
+  std::array<Line, N> p{};
   std::array<Real*, N> lambda{};
   std::array<std::size_t, N> offset{};
 };
 template <std::size_t N>
-LineData<N> lineData(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t G, bool xpbd) {
+LineData<N> lineData(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
+                     std::size_t G, bool xpbd) {
   LineData<N> d;
   for (std::size_t g = 0; g < G; ++g) {
     d.offset[g] = lines.start[line[g]];
-    d.p[g] = lines.particle.data() + d.offset[g];
-    d.rest[g] = lines.rest.data() + d.offset[g];
+    d.p[g].link = stretch + lines.firstLink(line[g]);
     d.lambda[g] = xpbd ? lines.lambda.data() + d.offset[g] : nullptr;
   }
   return d;
 }
 
 // The lines line[0, count) of a family, W at a time where W in a row are equally long (G = W),
-// else one (G = 1): solve(std::integral_constant<std::size_t, G>, particles, rests,
-// lambdas, offsets, n), each array holding G lines' pointers (lambdas null without XPBD) and
-// offsets their starts. A line's arithmetic does not depend on which lines it is solved beside.
-// (The vector solve takes up to W in a row instead: inLanes.)
+// else one (G = 1): solve(std::integral_constant<std::size_t, G>, lines, lambdas, offsets, n),
+// each array holding G lines' (lambdas null without XPBD) and offsets their slots. A line's arithmetic does not depend
+// on which lines it is solved beside. (The vector solve takes up to W in a row instead: inLanes.)
 template <std::size_t W, class Solve>
-void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t count, bool xpbd,
-              Solve&& solve) {
+void inGroups(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
+              std::size_t count, bool xpbd, Solve&& solve) {
   constexpr std::size_t G = W;
   const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
   const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t i, std::size_t n) {
-    const LineData<N> d = lineData<N>(lines, line + i, N, xpbd);
-    solve(size, d.p, d.rest, d.lambda, d.offset, n);
+    const LineData<N> d = lineData<N>(lines, stretch, line + i, N, xpbd);
+    solve(size, d.p, d.lambda, d.offset, n);
   };
   for (std::size_t i = 0; i < count;) {
     const std::size_t n = length(i);
@@ -260,11 +268,12 @@ void inGroups(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::
 }
 
 // The lines line[0, count) of a family, up to W at a time, as many equally long ones as follow
-// each other: solve(G, particles, rests, lambdas, offsets, n, lines), each array holding W lines'
-// pointers of which the first G are filled (lambdas null without XPBD), and lines their indices.
+// each other: solve(G, lines, lambdas, offsets, n, ids), each array holding W lines' of which the
+// first G are filled (lambdas null without XPBD), and ids their indices.
 // A lane left empty costs as much as a filled one, so a short group beats lines one by one.
 template <std::size_t W, class Solve>
-void inLanes(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::size_t count, bool xpbd, Solve&& solve) {
+void inLanes(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
+             std::size_t count, bool xpbd, Solve&& solve) {
   const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
   for (std::size_t i = 0; i < count;) {
     const std::size_t n = length(i);
@@ -274,8 +283,8 @@ void inLanes(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::s
     }
     std::size_t G = 1;
     while (G < W && i + G < count && length(i + G) == n) ++G;
-    const LineData<W> d = lineData<W>(lines, line + i, G, xpbd);
-    solve(G, d.p, d.rest, d.lambda, d.offset, n, line + i);
+    const LineData<W> d = lineData<W>(lines, stretch, line + i, G, xpbd);
+    solve(G, d.p, d.lambda, d.offset, n, line + i);
     i += G;
   }
 }
@@ -286,9 +295,12 @@ void inLanes(SolverScratch::LineFamily& lines, const std::uint32_t* line, std::s
 // of a link the tridiagonal step keeps a kink from growing, and g changes the step by a tenth at
 // most. (hang2 256: most rows are below it, every column above; the strains it reaches do not
 // change. Rest lengths stand in for lengths.)
-bool needsFullStep(const SolverScratch::LineFamily& lines, std::size_t l, const Real* mass, Real ratio) {
-  for (std::size_t k = lines.start[l]; k + 1 < lines.start[l + 1]; ++k) {
-    if (-lines.tension[k] >= ratio * lines.rest[k] * mass[lines.particle[k]]) return true;
+bool needsFullStep(const SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, std::size_t l,
+                   const Real* mass, Real ratio) {
+  const DistanceConstraint* link = stretch + lines.firstLink(l);
+  const float* tension = lines.tension.data() + lines.start[l];
+  for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {
+    if (-tension[k] >= ratio * link[k].restLength * mass[link[k].a]) return true;
   }
   return false;
 }
@@ -307,67 +319,100 @@ bool cpuHasAvx() {
 #endif
 }
 
-void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
-  const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
+void build(Cloth& cloth, SolverScratch& scratch, int threads) {
+  std::vector<DistanceConstraint>& stretch = cloth.rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
   const std::size_t n = cloth.rest.restPositions.size();
-  scratch.looseStretch.clear();
+  // The links are taken in the order of their particles, not of the array: which join a line then
+  // does not depend on the order the constraints come in, so building again from the order this
+  // leaves them in (a snapshot, another thread count) gives the same lines.
+  std::vector<std::uint32_t> byPair(stretch.size());
+  std::iota(byPair.begin(), byPair.end(), 0u);
+  const auto pair = [&](std::uint32_t k) {
+    const DistanceConstraint& c = stretch[k];
+    return std::pair{std::min(c.a, c.b), std::max(c.a, c.b)};
+  };
+  std::stable_sort(byPair.begin(), byPair.end(), [&](std::uint32_t l, std::uint32_t r) { return pair(l) < pair(r); });
+  std::vector<DistanceConstraint> ordered;  // the links of the lines, line by line; then the loose
+  ordered.reserve(stretch.size());
+  std::vector<std::uint32_t> from;  // where each came from
+  from.reserve(stretch.size());
+  std::array<std::vector<std::uint32_t>, 2> loose;
   std::size_t longest = 0;
   for (int family = 0; family < 2; ++family) {
     SolverScratch::LineFamily& lines = scratch.lines[static_cast<std::size_t>(family)];
     lines = {};
+    lines.linkBase = static_cast<std::uint32_t>(ordered.size());
     std::vector<std::uint8_t> degree(n, 0);
     std::vector<std::uint32_t> parent(n);
     std::iota(parent.begin(), parent.end(), 0u);
     std::vector<std::array<std::int64_t, 2>> next(n, {-1, -1});  // the constraints at each particle
-    for (std::uint32_t k = 0; k < stretch.size(); ++k) {
+    for (const std::uint32_t k : byPair) {
       const DistanceConstraint& c = stretch[k];
       const Vec3 d = glm::abs(cloth.rest.restPositions[c.b] - cloth.rest.restPositions[c.a]);
       const bool alongX = d.x >= std::max(d.y, d.z);
       if (alongX != (family == 0)) continue;
       const std::uint32_t ra = findRoot(parent, c.a), rb = findRoot(parent, c.b);
       if (degree[c.a] >= 2 || degree[c.b] >= 2 || ra == rb) {
-        scratch.looseStretch.push_back(k);
+        loose[static_cast<std::size_t>(family)].push_back(k);
         continue;
       }
       parent[ra] = rb;
       next[c.a][degree[c.a]++] = k;
       next[c.b][degree[c.b]++] = k;
     }
-    // Walk each line from one of its ends.
+    // Walk each line from one of its ends, turning each link to point along it.
     std::vector<std::uint8_t> done(n, 0);
+    std::uint32_t slots = 0;
     for (std::size_t start = 0; start < n; ++start) {
       if (degree[start] != 1 || done[start]) continue;
-      lines.start.push_back(static_cast<std::uint32_t>(lines.particle.size()));
+      lines.start.push_back(slots);
       std::size_t at = start;
-      std::int64_t from = -1;
+      std::int64_t previous = -1;
       std::size_t length = 0;
       while (true) {
         done[at] = 1;
-        lines.particle.push_back(static_cast<ParticleIndex>(at));
+        ++slots;
         ++length;
         std::int64_t link = -1;
         for (std::int64_t candidate : next[at]) {
-          if (candidate >= 0 && candidate != from) link = candidate;
+          if (candidate >= 0 && candidate != previous) link = candidate;
         }
-        if (link < 0) {
-          lines.rest.push_back(0.0f);
-          break;
-        }
-        const DistanceConstraint& c = stretch[static_cast<std::size_t>(link)];
-        lines.rest.push_back(c.restLength);
-        at = c.a == at ? c.b : c.a;
-        from = link;
+        if (link < 0) break;
+        DistanceConstraint c = stretch[static_cast<std::size_t>(link)];
+        if (c.a != at) std::swap(c.a, c.b);
+        ordered.push_back(c);
+        from.push_back(static_cast<std::uint32_t>(link));
+        at = c.b;
+        previous = link;
       }
       longest = std::max(longest, length);
     }
-    lines.start.push_back(static_cast<std::uint32_t>(lines.particle.size()));
-    lines.lambda.clear();  // sized by the XPBD solve, which alone uses it
+    lines.start.push_back(slots);
+  }
+  scratch.looseStretch.clear();
+  for (const std::vector<std::uint32_t>& family : loose) {
+    for (const std::uint32_t k : family) {
+      scratch.looseStretch.push_back(static_cast<std::uint32_t>(ordered.size()));
+      ordered.push_back(stretch[k]);
+      from.push_back(k);
+    }
+  }
+  // A torn cloth's constraints each name their recipe: the names move with them.
+  std::vector<std::uint32_t>& source = cloth.topology.source[static_cast<std::size_t>(ConstraintKind::stretch)];
+  if (cloth.topology.built && source.size() == from.size()) {
+    std::vector<std::uint32_t> moved(from.size());
+    for (std::size_t k = 0; k < from.size(); ++k) moved[k] = source[from[k]];
+    source.swap(moved);
+  }
+  stretch.swap(ordered);
+  for (SolverScratch::LineFamily& lines : scratch.lines) {
     const std::size_t count = lines.start.size() - 1;
     lines.besideNext.assign(count, 0);
     for (std::size_t l = 0; l + 1 < count; ++l) {
-      const std::uint32_t a = lines.start[l], b = lines.start[l + 1], length = b - a;
-      bool beside = lines.start[l + 2] - b == length;
-      for (std::uint32_t k = 0; beside && k < length; ++k) beside = lines.particle[b + k] == lines.particle[a + k] + 1;
+      const std::uint32_t length = lines.start[l + 1] - lines.start[l];
+      bool beside = lines.start[l + 2] - lines.start[l + 1] == length;
+      const Line here{stretch.data() + lines.firstLink(l)}, beyond{stretch.data() + lines.firstLink(l + 1)};
+      for (std::uint32_t k = 0; beside && k < length; ++k) beside = beyond[k] == here[k] + 1;
       lines.besideNext[l] = beside ? 1 : 0;
     }
   }
@@ -389,12 +434,13 @@ void beginSubstep(SolverScratch& scratch) {
 void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
           bool full, Workers& workers) {
   ParticleState& s = cloth.state;
+  const DistanceConstraint* stretch = cloth.rest.of(ConstraintKind::stretch).data();
   const bool fullStep = full && geometricStiffness;
   if (geometricStiffness) {
     const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
     for (SolverScratch::LineFamily& lines : scratch.lines) {  // sized here alone (zero: no tension yet)
-      lines.tension.resize(lines.rest.size(), 0.0f);
+      lines.tension.resize(lines.slots(), 0.0f);
     }
   }
   for (SolverScratch::LineFamily& lines : scratch.lines) {
@@ -402,7 +448,7 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     const std::size_t count = lines.start.size() - 1;
     // Shared out only where each thread gets a few thousand links: below that, waking a helper
     // costs more than it saves.
-    const std::size_t perLine = std::max<std::size_t>(lines.particle.size() / count, 1);
+    const std::size_t perLine = std::max<std::size_t>(lines.slots() / count, 1);
     const std::size_t grain = std::max<std::size_t>(2048 / perLine, 1);
     // The lines taut enough to need the full step (needsFullStep) are solved first, then the
     // others, each share taken by the workers in blocks: a full step costs about twice a
@@ -416,7 +462,7 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
           count,
           [&](std::size_t first, std::size_t last, int) {
             for (std::size_t l = first; l < last; ++l) {
-              lines.taut[l] = needsFullStep(lines, l, s.mass.data(), scratch.fullStepRatio) ? 1 : 0;
+              lines.taut[l] = needsFullStep(lines, stretch, l, s.mass.data(), scratch.fullStepRatio) ? 1 : 0;
             }
           },
           grain);
@@ -448,9 +494,9 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
             const std::uint32_t* line = lines.order.data() + from + first;
             if (stiff) {
               const auto solveStiff = [&]<std::size_t W>(std::integral_constant<std::size_t, W>) {
-                inLanes<W>(lines, line, last - first, xpbd,
-                           [&](std::size_t G, const auto& p, const auto& rest, const auto& lambda, const auto& offset,
-                               std::size_t n, const std::uint32_t* ids) {
+                inLanes<W>(lines, stretch, line, last - first, xpbd,
+                           [&](std::size_t G, const auto& p, const auto& lambda, const auto& offset, std::size_t n,
+                               const std::uint32_t* ids) {
                              // The tension is read and summed in the same array: a line's gather
                              // reads its links' before its scatter adds to them.
                              std::array<float*, W> tension{};
@@ -461,10 +507,10 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                                for (std::size_t g = 0; consecutive && g + 1 < W; ++g) {
                                  consecutive = ids[g + 1] == ids[g] + 1 && lines.besideNext[ids[g]];
                                }
-                               solveStiffLines<W, W>(s, G, p, rest, lambda, tension, restart, n, stiffness, alpha, rows,
+                               solveStiffLines<W, W>(s, G, p, lambda, tension, restart, n, stiffness, alpha, rows,
                                                      consecutive);
                              } else {
-                               solveStiffLines<W, 0>(s, G, p, rest, lambda, tension, restart, n, stiffness, alpha, rows,
+                               solveStiffLines<W, 0>(s, G, p, lambda, tension, restart, n, stiffness, alpha, rows,
                                                      false);
                              }
                            });
@@ -476,14 +522,14 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
               }
             } else {
               // With geometric stiffness every solve adds its multipliers to the tension sums.
-              inGroups<4>(lines, line, last - first, xpbd,
-                          [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& rest,
-                                             const auto& lambda, const auto& offset, std::size_t n) {
+              inGroups<4>(lines, stretch, line, last - first, xpbd,
+                          [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
+                                             const auto& offset, std::size_t n) {
                             std::array<float*, G> summed{};
                             for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
                               summed[g] = lines.tension.data() + offset[g];
                             }
-                            solveLines<G>(s, p, rest, lambda, summed, restart, n, stiffness, alpha,
+                            solveLines<G>(s, p, lambda, summed, restart, n, stiffness, alpha,
                                           scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
                                           scratch.lineSolution.data() + slice);
                           });
@@ -516,6 +562,7 @@ namespace {
 bool stretchedBeyond(const Cloth& cloth, const SolverScratch& scratch, Real tolerance, Workers& workers) {
   const Vec3* x = cloth.state.position.data();
   const Real* w = cloth.state.inverseMass.data();
+  const DistanceConstraint* stretch = cloth.rest.of(ConstraintKind::stretch).data();
   const Real scale = (1.0 + tolerance) * (1.0 + tolerance);
   std::atomic<bool> found{false};
   for (const SolverScratch::LineFamily& lines : scratch.lines) {
@@ -524,11 +571,12 @@ bool stretchedBeyond(const Cloth& cloth, const SolverScratch& scratch, Real tole
       if (found.load(std::memory_order_relaxed)) return;
       bool beyond = false;
       for (std::size_t l = first; l < last; ++l) {
-        for (std::size_t k = lines.start[l], end = lines.start[l + 1] - 1; k < end; ++k) {
-          const ParticleIndex a = lines.particle[k], b = lines.particle[k + 1];
-          const Vec3 d = x[b] - x[a];
-          const Real r = lines.rest[k];
-          beyond |= glm::dot(d, d) > scale * (r * r) && w[a] + w[b] > 0.0;
+        const DistanceConstraint* link = stretch + lines.firstLink(l);
+        for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {
+          const DistanceConstraint& c = link[k];
+          const Vec3 d = x[c.b] - x[c.a];
+          const Real r = c.restLength;
+          beyond |= glm::dot(d, d) > scale * (r * r) && w[c.a] + w[c.b] > 0.0;
         }
       }
       if (beyond) found.store(true, std::memory_order_relaxed);

@@ -24,8 +24,12 @@ bool cpuHasAvx();
 
 // Rebuilds scratch.lines and scratch.looseStretch from the cloth's stretch constraints. A link
 // goes to the family of its rest direction (along x, or not) and joins a line there unless that
-// would give a particle three links in the family or close a loop; then it is loose.
-void build(const Cloth& cloth, SolverScratch& scratch, int threads);
+// would give a particle three links in the family or close a loop (the links taken in the order of
+// their particles); then it is loose. The lines read their particles and rest lengths from the
+// constraints, which this puts in line order: the rows' links line by line, then the columns',
+// then the loose ones; each line's link k from its particle k (a) to k + 1 (b). A torn cloth's
+// recipe names (topology.source) move with them.
+void build(Cloth& cloth, SolverScratch& scratch, int threads);
 
 // One Newton step of every line's projection from where its particles are now: the rows, then the
 // columns. `stiffness` scales each correction (position model); with `xpbd`, alphaTilde =

@@ -40,38 +40,42 @@ __m256 toFloats(__m256d low, __m256d high) {
 }
 // 1.0 where a comparison holds, else 0.0.
 __m256d ones(__m256d holds) { return _mm256_and_pd(holds, _mm256_set1_pd(1.0)); }
+// Particle k of a line whose link k joins particle k (a) to k + 1 (b).
+std::size_t particleOf(const DistanceConstraint* link, std::size_t k) { return k == 0 ? link[0].a : link[k - 1].b; }
 
 }  // namespace
 
 void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const double* position,
-                           const double* inverseMass, const double* mass, const std::uint32_t* first,
-                           const float* const* rest, const double* const* lambda, const float* const* tension,
-                           const double* perUnitMass, double alphaTilde) {
+                           const double* inverseMass, const double* mass, const DistanceConstraint* first,
+                           const DistanceConstraint* const* lineLinks, const double* const* lambda,
+                           const float* const* tension, const double* perUnitMass, double alphaTilde) {
   const std::size_t links = n - 1;
   const __m256d zero = _mm256_setzero_pd(), alpha = _mm256_set1_pd(alphaTilde);
   const __m256d scaleLow = _mm256_loadu_pd(perUnitMass), scaleHigh = _mm256_loadu_pd(perUnitMass + 4);
   for (std::size_t k = 0; k < n; ++k) {
     SolverScratch::StiffRows& r = rows[k];
-    const std::size_t at = first[k];
+    const std::size_t at = particleOf(first, k);
     const __m256d wLow = _mm256_loadu_pd(inverseMass + at), wHigh = _mm256_loadu_pd(inverseMass + at + 4);
-    _mm256_storeu_ps(r.mass, toFloats(_mm256_mul_pd(_mm256_loadu_pd(mass + at), scaleLow),
+    // (StiffRows: v[0] and v[1] hold the particle's mass and whether it moves until the solve.)
+    _mm256_storeu_ps(r.v[0], toFloats(_mm256_mul_pd(_mm256_loadu_pd(mass + at), scaleLow),
                                       _mm256_mul_pd(_mm256_loadu_pd(mass + at + 4), scaleHigh)));
     _mm256_storeu_ps(
-        r.moves, toFloats(ones(_mm256_cmp_pd(wLow, zero, _CMP_GT_OQ)), ones(_mm256_cmp_pd(wHigh, zero, _CMP_GT_OQ))));
+        r.v[1], toFloats(ones(_mm256_cmp_pd(wLow, zero, _CMP_GT_OQ)), ones(_mm256_cmp_pd(wHigh, zero, _CMP_GT_OQ))));
     if (k == links) {
-      float* const none[] = {r.nx, r.ny, r.nz, r.rhs, r.g, r.live};  // no link after the last particle
+      float* const none[] = {r.nx, r.ny, r.nz, r.yl, r.g, r.schur};  // no link after the last particle
       for (float* lanes : none) _mm256_storeu_ps(lanes, _mm256_setzero_ps());
       continue;
     }
     if (k + 4 < n) {  // the rows ahead: particles a row apart are a lattice's width apart in memory
-      const double* ahead = position + 3 * std::size_t{first[k + 4]};
+      const std::size_t later = first[k + 3].b;
+      const double* ahead = position + 3 * later;
       _mm_prefetch(reinterpret_cast<const char*>(ahead), _MM_HINT_T0);
       _mm_prefetch(reinterpret_cast<const char*>(ahead + 8), _MM_HINT_T0);
       _mm_prefetch(reinterpret_cast<const char*>(ahead + 16), _MM_HINT_T0);
-      _mm_prefetch(reinterpret_cast<const char*>(inverseMass + first[k + 4]), _MM_HINT_T0);
-      _mm_prefetch(reinterpret_cast<const char*>(mass + first[k + 4]), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(inverseMass + later), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(mass + later), _MM_HINT_T0);
     }
-    const std::size_t next = first[k + 1];
+    const std::size_t next = first[k].b;
     const double* from = position + 3 * at;
     const double* to = position + 3 * next;
     // The links' differences, to - from, four particles at a time.
@@ -88,11 +92,11 @@ void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const 
     _mm256_storeu_ps(r.nz, toFloats(d[0].z, d[1].z));
     const __m256d toWLow = _mm256_loadu_pd(inverseMass + next), toWHigh = _mm256_loadu_pd(inverseMass + next + 4);
     _mm256_storeu_ps(
-        r.live, toFloats(ones(_mm256_cmp_pd(_mm256_add_pd(_mm256_add_pd(wLow, toWLow), alpha), zero, _CMP_GT_OQ)),
-                         ones(_mm256_cmp_pd(_mm256_add_pd(_mm256_add_pd(wHigh, toWHigh), alpha), zero, _CMP_GT_OQ))));
+        r.schur, toFloats(ones(_mm256_cmp_pd(_mm256_add_pd(_mm256_add_pd(wLow, toWLow), alpha), zero, _CMP_GT_OQ)),
+                          ones(_mm256_cmp_pd(_mm256_add_pd(_mm256_add_pd(wHigh, toWHigh), alpha), zero, _CMP_GT_OQ))));
     // Each line's own rest length, multiplier and tension, as the scalar gather takes them.
     for (std::size_t g = 0; g < 8; ++g) {
-      r.rhs[g] = static_cast<float>(rest[g][k] - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
+      r.yl[g] = static_cast<float>(lineLinks[g][k].restLength - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
       const double minus = -static_cast<double>(tension[g][k]);
       r.g[g] = static_cast<float>((minus < 0.0 ? 0.0 : minus) * perUnitMass[g]);  // std::max(minus, 0.0)
     }
@@ -100,15 +104,19 @@ void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const 
 }
 
 void scatterConsecutiveWide(const SolverScratch::StiffRows* rows, std::size_t n, double* position,
-                            const std::uint32_t* first, double stiffness) {
+                            const double* inverseMass, const DistanceConstraint* first, double stiffness) {
   const __m256d scale = _mm256_set1_pd(stiffness);
-  const __m256 zero = _mm256_setzero_ps();
+  const __m256d zero = _mm256_setzero_pd();
   for (std::size_t j = 0; j < n; ++j) {
     const SolverScratch::StiffRows& r = rows[j];
-    const __m256 moves = _mm256_cmp_ps(_mm256_loadu_ps(r.moves), zero, _CMP_NEQ_UQ);  // != 0.0f
-    double* x = position + 3 * std::size_t{first[j]};
+    const std::size_t at = particleOf(first, j);
+    // Which particles move: inverse mass above 0, as the gather found them.
+    const __m256 moving = toFloats(ones(_mm256_cmp_pd(_mm256_loadu_pd(inverseMass + at), zero, _CMP_GT_OQ)),
+                                   ones(_mm256_cmp_pd(_mm256_loadu_pd(inverseMass + at + 4), zero, _CMP_GT_OQ)));
+    const __m256 moves = _mm256_cmp_ps(moving, _mm256_setzero_ps(), _CMP_NEQ_UQ);  // != 0.0f
+    double* x = position + 3 * at;
     if (j + 4 < n) {
-      const double* ahead = position + 3 * std::size_t{first[j + 4]};
+      const double* ahead = position + 3 * std::size_t{first[j + 3].b};
       _mm_prefetch(reinterpret_cast<const char*>(ahead), _MM_HINT_T0);
       _mm_prefetch(reinterpret_cast<const char*>(ahead + 8), _MM_HINT_T0);
       _mm_prefetch(reinterpret_cast<const char*>(ahead + 16), _MM_HINT_T0);
@@ -136,9 +144,10 @@ void scatterConsecutiveWide(const SolverScratch::StiffRows* rows, std::size_t n,
 #else
 // Not built for AVX (not an x86 machine): never called, as the CPU check says no.
 void gatherConsecutiveWide(SolverScratch::StiffRows*, std::size_t, const double*, const double*, const double*,
-                           const std::uint32_t*, const float* const*, const double* const*, const float* const*,
-                           const double*, double) {}
-void scatterConsecutiveWide(const SolverScratch::StiffRows*, std::size_t, double*, const std::uint32_t*, double) {}
+                           const DistanceConstraint*, const DistanceConstraint* const*, const double* const*,
+                           const float* const*, const double*, double) {}
+void scatterConsecutiveWide(const SolverScratch::StiffRows*, std::size_t, double*, const double*,
+                            const DistanceConstraint*, double) {}
 #endif
 
 }  // namespace drape::sim::lines

@@ -12,16 +12,17 @@ namespace drape::sim::lines {
 // solveStiffLanes for all eight lanes of rows[0, n), alphaTilde one float per lane.
 void solveStiffLanesWide(SolverScratch::StiffRows* rows, std::size_t n, const float* alphaTilde);
 
-// solveStiffLines' gather (lines.cpp) for eight lines whose particles at k are first[k] to
-// first[k] + 7 (a lattice's neighbouring columns, say), position holding x, y, z per particle: the
-// same rows[0, n), bit for bit. rest, lambda (null entries without XPBD) and tension: each line's.
+// solveStiffLines' gather (lines.cpp) for eight lines whose particles at k are particle k of
+// `first` (line 0's links, as lines.cpp's Line reads them) to it + 7 (a lattice's neighbouring
+// columns, say), position holding x, y, z per particle: the same rows[0, n), bit for bit. links
+// (for the rest lengths), lambda (null entries without XPBD) and tension: each line's.
 void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const double* position,
-                           const double* inverseMass, const double* mass, const std::uint32_t* first,
-                           const float* const* rest, const double* const* lambda, const float* const* tension,
-                           const double* perUnitMass, double alphaTilde);
-// ... and its scatter of the moves (the multipliers are the caller's): each particle that moves by
-// yx * stiffness.
+                           const double* inverseMass, const double* mass, const DistanceConstraint* first,
+                           const DistanceConstraint* const* links, const double* const* lambda,
+                           const float* const* tension, const double* perUnitMass, double alphaTilde);
+// ... and its scatter of the moves (the multipliers are the caller's): each particle free to move
+// (inverse mass above 0) by yx * stiffness.
 void scatterConsecutiveWide(const SolverScratch::StiffRows* rows, std::size_t n, double* position,
-                            const std::uint32_t* first, double stiffness);
+                            const double* inverseMass, const DistanceConstraint* first, double stiffness);
 
 }  // namespace drape::sim::lines

@@ -361,7 +361,7 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
     }
     if (solver.lines) {
-      for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.rest.size(), 0.0);
+      for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.slots(), 0.0);
     }
   }
   if (solver.lines && solver.geometricStiffness) lines::beginSubstep(scratch);

@@ -166,17 +166,17 @@ struct Link {
 };
 
 // Link j from what solveStiffLines gathered into row j: the difference of its particles (in nx, ny,
-// nz), its rest length less alpha~ lambda (rhs), its tension over the unit mass (g) and 1 if
-// anything can move it (live). A link with no direction is dead. Keeps in the row what the back
+// nz), its rest length less alpha~ lambda (in yl), its tension over the unit mass (g) and 1 if
+// anything can move it (in schur). A link with no direction is dead. Keeps in the row what the back
 // substitution reads again: the direction and g.
 template <class V>
 Link<V> normalise(StiffRow& r) {
   const Lane3<V> d{load<V>(r.nx), load<V>(r.ny), load<V>(r.nz)};
   const V length2 = dot(d, d);
-  const V live = load<V>(r.live) * ones<V>(length2 > 1e-20f);
+  const V live = load<V>(r.schur) * ones<V>(length2 > 1e-20f);
   const V length = squareRoot(length2 * live + (1.0f - live));  // 1 where dead
   const V inverseLength = live / length;
-  const Link<V> link{d * inverseLength, load<V>(r.g) * inverseLength, (length - load<V>(r.rhs)) * live, live};
+  const Link<V> link{d * inverseLength, load<V>(r.g) * inverseLength, (length - load<V>(r.yl)) * live, live};
   keep(r.nx, link.unit.x);
   keep(r.ny, link.unit.y);
   keep(r.nz, link.unit.z);
@@ -185,8 +185,8 @@ Link<V> normalise(StiffRow& r) {
 }
 
 // The elimination of solveStiffLines for the first lanes (as many as V holds) of rows[0, n),
-// gathered; alphaTilde per lane. On return each row's yx holds its particle's move and yl its
-// link-before's multiplier.
+// gathered (the particle's mass in v[0], 1 if it moves in v[1]; StiffRows); alphaTilde per lane. On
+// return each row's yx holds its particle's move and yl its link-before's multiplier.
 template <class V>
 void solveStiffLanes(StiffRow* rows, std::size_t n, V alphaTilde) {
   const auto direction = [](const StiffRow& r) { return Lane3<V>{load<V>(r.nx), load<V>(r.ny), load<V>(r.nz)}; };
@@ -198,8 +198,8 @@ void solveStiffLanes(StiffRow* rows, std::size_t n, V alphaTilde) {
   LaneSym3<V> nextAcross = across(next.unit, next.pull);  // G of the link after the node
   {
     StiffRow& r = rows[0];
-    const V m = load<V>(r.mass);
-    const LaneSym3<V> inverseA = inverse(LaneSym3<V>{m, m, m, zero, zero, zero} + nextAcross) * load<V>(r.moves);
+    const V m = load<V>(r.v[0]);
+    const LaneSym3<V> inverseA = inverse(LaneSym3<V>{m, m, m, zero, zero, zero} + nextAcross) * load<V>(r.v[1]);
     keepSym(r.inverse, inverseA);
     P = inverseA;
     keep3(r.v, zx);
@@ -224,10 +224,10 @@ void solveStiffLanes(StiffRow* rows, std::size_t n, V alphaTilde) {
     const Lane3<V> yx = (zx - unit * nz) * pull;
     V yl = live * (link.rhs - nz);
     // A = m I + G_{j-1} + G_j - G_{j-1} P G_{j-1}
-    const V m = load<V>(r.mass);
+    const V m = load<V>(r.v[0]);
     const LaneSym3<V> A = LaneSym3<V>{m, m, m, zero, zero, zero} + linkAcross + nextAcross +
                           (P + outer(unit, Pn) * -one + outer(unit) * nPn) * (-pull * pull);
-    const LaneSym3<V> inverseA = inverse(A) * load<V>(r.moves);
+    const LaneSym3<V> inverseA = inverse(A) * load<V>(r.v[1]);
     const Lane3<V> v = inverseA * b;
     V schur = c - dot(b, v);
     // Both particles held (or a zero pivot): the link cannot be corrected.

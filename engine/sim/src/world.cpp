@@ -323,7 +323,11 @@ void World::plan(std::size_t c) {
     const batches::Batches made = batches::colour(cloth.rest, cloth.topology.built ? &cloth.topology.source : nullptr);
     scratch.batchStart = made.start;
     scratch.sequentialTail = made.sequentialTail;
-    lines::build(cloths_[c], scratch, workers_->threads());
+    // ... except the stretch constraints, which the lines put in line order and solve (a loose one
+    // one by one): they have no batches.
+    lines::build(cloth, scratch, workers_->threads());
+    scratch.batchStart[static_cast<std::size_t>(ConstraintKind::stretch)].clear();
+    scratch.sequentialTail[static_cast<std::size_t>(ConstraintKind::stretch)] = false;
   } else {
     scratch.batchStart = {};
     scratch.lines = {};
@@ -377,8 +381,8 @@ MemoryUse World::memoryUse() const {
                 bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
-      m.lines += bytes(f.start) + bytes(f.particle) + bytes(f.rest) + bytes(f.lambda) + bytes(f.tension) +
-                 bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
+      m.lines +=
+          bytes(f.start) + bytes(f.lambda) + bytes(f.tension) + bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
     }
   }
   for (const std::vector<Vec3>& good : lastGood_) m.guard += bytes(good);

@@ -71,12 +71,19 @@ struct SolverScratch {
   };
   Tethers tethers;
   // Lines (solver.lines): the stretch constraints as chains, rows and columns on a lattice, each
-  // solved at once (lines.hpp). Built from the constraints whenever they change.
+  // solved at once (lines.hpp). Built from the constraints whenever they change. A line keeps no
+  // copy of its particles or rest lengths: lines::build puts the cloth's stretch constraints in line
+  // order, each line's links one after another and each link from the line's particle k (its a)
+  // to k + 1 (its b), so the line reads them there.
   struct LineFamily {
-    std::vector<std::uint32_t> start;  // line l holds particle[start[l] .. start[l + 1])
-    std::vector<ParticleIndex> particle;
-    std::vector<RestReal> rest;  // m, link k joins particle[k] and particle[k + 1] (unused at a line's end)
-    std::vector<Real> lambda;    // XPBD: multiplier of link k, reset each substep
+    // Line l has start[l + 1] - start[l] particles, and a slot for each in the per-link arrays
+    // below (lambda, tension): link k of the line (k < its particles - 1) is slot start[l] + k.
+    std::vector<std::uint32_t> start;
+    std::uint32_t linkBase = 0;  // the family's first line's first link, in the stretch constraints
+    std::size_t slots() const { return start.empty() ? 0 : start.back(); }
+    // Line l's first link in the cloth's stretch constraints.
+    std::size_t firstLink(std::size_t l) const { return linkBase + start[l] - l; }
+    std::vector<Real> lambda;  // XPBD: multiplier of link k, reset each substep
     // solver.geometricStiffness: the sum of link k's multipliers (its tension times h^2, negative
     // when pulled) over this substep's steps so far, or before its first, over the last substep's.
     // The first step reads it and starts it again (fresh). Single precision: it only scales the
@@ -112,14 +119,15 @@ struct SolverScratch {
     // Up to 8 lines side by side, an AVX register of floats; the solve takes 8 where the CPU has
     // AVX (chosen at run time, lines.cpp) and else 4, an SSE register, in the first lanes. Plain
     // arrays: the AVX solve (lines_wide.cpp, built for AVX) instantiates no library template.
+    // The gather's inputs that only the forward elimination reads are kept where it then writes
+    // the row's results (it reads them first): the link's constraint value C + alpha~ lambda in yl,
+    // 1 if the solve corrects the link (else 0) in schur, the particle's mass in v[0] and 1 if it is
+    // free to move in v[1]. 672 bytes a row, not 800: at N = 64 that is 2 bytes a particle.
     static constexpr std::size_t kLanes = 8;
     using Lanes = float[kLanes];
-    Lanes nx, ny, nz;   // direction of the link to the next particle
-    Lanes g;            // its geometric stiffness: G = g (I - n n^T)
-    Lanes rhs;          // its constraint value, C + alpha~ lambda
-    Lanes live;         // 1: a link the solve corrects; 0: not
-    Lanes mass, moves;  // the particle's mass, and 1 if it is free to move
-    Lanes inverse[6];   // A^-1 of its eliminated block (symmetric: xx yy zz xy xz yz)
+    Lanes nx, ny, nz;  // direction of the link to the next particle (gathered: the difference)
+    Lanes g;           // its geometric stiffness: G = g (I - n n^T)
+    Lanes inverse[6];  // A^-1 of its eliminated block (symmetric: xx yy zz xy xz yz)
     Lanes v[3], b[3], yx[3];
     Lanes schur;  // the inverse of the link multiplier's pivot
     Lanes yl;
