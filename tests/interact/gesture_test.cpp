@@ -244,10 +244,10 @@ TEST(Gesture, TearRipsTheClothAndOnePieceIsPickedUpAlone) {
   const sim::Finger* finger = played.world->finger(7);
   ASSERT_NE(finger, nullptr);
   ASSERT_FALSE(finger->grips.empty());
-  const std::uint32_t lifted = cloth.piece[finger->grips.front().particle];
+  const std::uint32_t lifted = cloth.pieceOf(finger->grips.front().particle);
   int onTable = 0, others = 0;
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-    if (cloth.piece[i] == lifted) continue;
+    if (cloth.pieceOf(i) == lifted) continue;
     ++others;
     onTable += cloth.state.position[i].y < 0.02;
   }
@@ -261,10 +261,10 @@ TEST(Gesture, CutPartsTheClothAndOneHalfIsPickedUpAlone) {
   played.until();
   const sim::Cloth& cloth = played.cloth();
   EXPECT_EQ(cloth.pieceCount, 2u);
-  const std::uint32_t lifted = cloth.piece[played.world->finger(2)->grips.front().particle];
+  const std::uint32_t lifted = cloth.pieceOf(played.world->finger(2)->grips.front().particle);
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
     const Vec3 x = cloth.state.position[i];
-    if (cloth.piece[i] != lifted) {
+    if (cloth.pieceOf(i) != lifted) {
       EXPECT_LT(x.y, 0.02);
     }
   }

@@ -199,6 +199,17 @@ World pulledApart(Real threshold, int steps) {
   return world;
 }
 
+TEST(Tearing, AClothInOnePieceKeepsNoPieceNumbers) {
+  // Telling pieces apart costs 4 bytes a particle: a cloth pays for it once it is in two.
+  const World whole = pulledApart(1.3, 1);
+  EXPECT_EQ(whole.cloths()[0].pieceCount, 1u);
+  EXPECT_TRUE(whole.cloths()[0].piece.empty());
+  EXPECT_EQ(whole.cloths()[0].pieceOf(5), 0u);
+  const World torn = pulledApart(1.3, 60);
+  EXPECT_GE(torn.cloths()[0].pieceCount, 2u);
+  EXPECT_EQ(torn.cloths()[0].piece.size(), torn.cloths()[0].state.position.size());
+}
+
 TEST(Tearing, PullingApartSplitsTheSheetIntoPiecesWithoutTrianglesAcrossTheGap) {
   const World world = pulledApart(1.3, 60);
   const Cloth& cloth = world.cloths()[0];
@@ -206,10 +217,10 @@ TEST(Tearing, PullingApartSplitsTheSheetIntoPiecesWithoutTrianglesAcrossTheGap) 
   EXPECT_GT(cloth.state.position.size(), 121u);  // particles were split, not deleted
   EXPECT_NEAR(totalMass(world), 1.0, 1e-12);
   // The pinned edge and the pulled edge are on different pieces, and no triangle spans the gap.
-  EXPECT_NE(cloth.piece[cloth.rest.index(0, 5)], cloth.piece[cloth.rest.index(10, 5)]);
+  EXPECT_NE(cloth.pieceOf(cloth.rest.index(0, 5)), cloth.pieceOf(cloth.rest.index(10, 5)));
   EXPECT_LT(worstTriangleStretch(cloth), 1.3 * 1.3);
   for (const auto& list : cloth.rest.constraints) {
-    for (const DistanceConstraint& c : list) EXPECT_EQ(cloth.piece[c.a], cloth.piece[c.b]);
+    for (const DistanceConstraint& c : list) EXPECT_EQ(cloth.pieceOf(c.a), cloth.pieceOf(c.b));
   }
 }
 
@@ -281,7 +292,7 @@ TEST(Cutting, ASwipeAcrossTheSheetMakesTwoPiecesThatMoveApart) {
   Real farHighest = -1.0, nearLowest = 1.0;
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
     const Vec3 x = cloth.state.position[i];
-    if (cloth.piece[i] == cloth.piece[cloth.rest.index(0, 0)])
+    if (cloth.pieceOf(i) == cloth.pieceOf(cloth.rest.index(0, 0)))
       farHighest = std::max(farHighest, x.y);
     else
       nearLowest = std::min(nearLowest, x.y);

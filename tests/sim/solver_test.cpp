@@ -1095,7 +1095,7 @@ TEST(Tethers, NoneReachesAcrossACut) {
   // (The cut splits the particles of column n / 2: each original stays with the left half, and its
   // copy, which has no tethers, goes with the right.)
   const ParticleIndex leftPin = cloth.rest.index(0, 0), nextToCut = cloth.rest.index(n / 2 + 1, 0);
-  ASSERT_NE(cloth.piece[nextToCut], cloth.piece[leftPin]);
+  ASSERT_NE(cloth.pieceOf(nextToCut), cloth.pieceOf(leftPin));
   const Real rest = glm::distance(cloth.rest.restPositions[nextToCut], cloth.rest.restPositions[leftPin]);
   ASSERT_EQ(world.run(120), StepStatus::ok);
   EXPECT_GT(glm::distance(cloth.state.position[nextToCut], cloth.state.position[leftPin]), rest + 0.1);

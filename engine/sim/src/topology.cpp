@@ -460,6 +460,10 @@ std::vector<std::uint32_t> pieces(const ClothRest& rest, std::uint32_t& count) {
     if (rootLabel[root] == UINT32_MAX) rootLabel[root] = count++;
     label[i] = rootLabel[root];
   }
+  if (count <= 1) {
+    count = 1;  // (a cloth of no particles is one piece too)
+    return {};
+  }
   return label;
 }
 

@@ -25,7 +25,8 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
 bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, std::vector<ParticleSplit>& splits);
 
 // Connected pieces: per particle, the number of its piece (0, 1, ... in order of the lowest
-// particle), joined through triangles and constraints. `count` receives the number of pieces.
+// particle), joined through triangles and constraints; empty if there is one piece (Cloth::piece).
+// `count` receives the number of pieces.
 std::vector<std::uint32_t> pieces(const ClothRest& rest, std::uint32_t& count);
 
 }  // namespace drape::sim::topology

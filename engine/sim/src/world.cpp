@@ -220,7 +220,7 @@ void World::buildTethers(std::size_t c) {
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
     if (cloth.state.inverseMass[i] == 0.0) continue;
     for (const std::size_t p : pins) {
-      if (cloth.piece[i] != cloth.piece[p]) continue;
+      if (cloth.pieceOf(i) != cloth.pieceOf(p)) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
       const RestReal length = toRestLength(glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]));
       tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
@@ -658,10 +658,10 @@ void World::grab(Finger& finger, std::size_t c, ParticleIndex nearest) {
   Cloth& cloth = cloths_[c];
   ParticleState& s = cloth.state;
   const Real r2 = finger.radius * finger.radius;
-  const std::uint32_t piece = cloth.piece[nearest];
+  const std::uint32_t piece = cloth.pieceOf(nearest);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
     const Vec3 offset = s.position[i] - finger.position;
-    if (held_[c][i] || cloth.piece[i] != piece || glm::dot(offset, offset) > r2) continue;
+    if (held_[c][i] || cloth.pieceOf(i) != piece || glm::dot(offset, offset) > r2) continue;
     held_[c][i] = 1;
     s.inverseMass[i] = 0.0;
     finger.grips.push_back({static_cast<int>(c), static_cast<ParticleIndex>(i), offset});
@@ -819,7 +819,7 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
   // A tether may not reach across a tear.
   std::vector<SolverScratch::Tethers::Tether> tethers = scratch.tethers.list();
-  std::erase_if(tethers, [&](const auto& t) { return cloth.piece[t.particle] != cloth.piece[t.pin]; });
+  std::erase_if(tethers, [&](const auto& t) { return cloth.pieceOf(t.particle) != cloth.pieceOf(t.pin); });
   scratch.tethers.assign(tethers);
   topologyVersion_ = nextTopologyVersion();
 }

@@ -23,9 +23,12 @@ struct Cloth {
   ClothRest rest;
   ParticleState state;
   ClothSettings settings;
-  Topology topology;                 // built the first time the cloth tears or is cut
-  std::vector<std::uint32_t> piece;  // per particle: which connected piece it belongs to
+  Topology topology;  // built the first time the cloth tears or is cut
+  // Per particle: which connected piece it belongs to (0, 1, ... in order of the lowest particle).
+  // Empty while the cloth is in one piece: a cloth that is never torn or cut pays nothing for it.
+  std::vector<std::uint32_t> piece;
   std::uint32_t pieceCount = 1;
+  std::uint32_t pieceOf(std::size_t particle) const { return piece.empty() ? 0 : piece[particle]; }
 };
 
 // A finger holding particles (the seed's sticky finger). Each held particle keeps its offset from
