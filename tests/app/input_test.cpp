@@ -231,6 +231,18 @@ TEST(Session, SaveAndLoadBringBackATornClothExactly) {
   std::filesystem::remove(huge);
   ASSERT_TRUE(tooLong);
   EXPECT_NE(tooLong->find("cloths.0.stretch.0"), std::string::npos) << *tooLong;
+  // So is a mass single precision cannot hold (masses are kept in it too), positive but rounding
+  // to 0 as much as too large.
+  for (const double mass : {1e300, 1e-300}) {
+    document["cloths"][0]["stretch"][0][2] = 0.01;
+    document["cloths"][0]["masses"][3] = mass;
+    std::ofstream(huge) << document.dump();
+    Session heavy("desk");
+    const std::optional<std::string> badMass = heavy.load(huge);
+    std::filesystem::remove(huge);
+    ASSERT_TRUE(badMass) << mass;
+    EXPECT_NE(badMass->find("cloths.0.masses.3"), std::string::npos) << *badMass;
+  }
   const sim::Cloth& back = loaded.world().cloths()[0];
   EXPECT_EQ(back.rest.triangles, saved.rest.triangles);
   EXPECT_EQ(back.state.position, saved.state.position);

@@ -157,8 +157,14 @@ TEST(Gesture, PinchLiftsWhatTheFingersHold) {
 TEST(Gesture, CrumpleGathersTheClothIntoAPile) {
   Played played("desk", "crumple");
   const Real before = spread(played.cloth());
+  // Just before the six fingers let go (at 1.9 s) the cloth is gathered to under half its spread
+  // (measured 0.37-0.38 of it, whatever the rounding).
+  played.until(1.85);
+  EXPECT_LT(spread(played.cloth()), 0.5 * before) << spread(played.cloth()) << " from " << before;
+  // Let go, the pile relaxes, by how much is chaotic: a mass changed by 1e-7 of itself ends
+  // anywhere from 0.6 to 0.94 of the spread. It stays gathered, folded, and above the table.
   played.until();
-  EXPECT_LT(spread(played.cloth()), 0.75 * before) << spread(played.cloth()) << " from " << before;
+  EXPECT_LT(spread(played.cloth()), 0.97 * before) << spread(played.cloth()) << " from " << before;
   EXPECT_GT(highest(played.cloth()), 0.03);  // folds rise out of the table
   EXPECT_GT(lowest(played.cloth()), 0.0);    // none under it
 }

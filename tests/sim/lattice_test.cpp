@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "drape/sim/cloth.hpp"
+#include "drape/sim/world.hpp"
 
 namespace drape::sim {
 namespace {
@@ -45,6 +46,19 @@ TEST(Lattice, RestLengthsSinglePrecisionCannotHoldAreRefused) {
   // A lattice too large or too fine for them is refused, not built with infinite or zero lengths.
   EXPECT_THROW(buildLattice({3, 3, 1e39, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
   EXPECT_THROW(buildLattice({3, 3, 1e-100, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
+}
+
+TEST(Lattice, MassesSinglePrecisionCannotHoldAreRefused) {
+  EXPECT_EQ(toMass(0.25), 0.25f);
+  EXPECT_EQ(toMass(0.1), 0.1f);  // rounded as a float rounds
+  for (const Real bad : {0.0, -1.0, 1e39, 1e-50, std::numeric_limits<Real>::infinity(), std::nan("")}) {
+    EXPECT_THROW(toMass(bad), std::invalid_argument) << bad;
+  }
+  // A world whose particles would weigh that is refused, not built with masses of 0.
+  WorldSettings settings;
+  settings.cloths.push_back({});
+  settings.cloths[0].masses.push_back({0, 0, 1e-300});
+  EXPECT_THROW(World{settings}, std::invalid_argument);
 }
 
 TEST(Lattice, IndexIsRowMajorAndPlanesPointTheRightWay) {

@@ -243,7 +243,7 @@ TEST(Lines, TheStiffSolveDoesNotDependOnHowMuchTheClothWeighs) {
   // solve works in units of a line's own mass, so a chain of a picogram moves as one of a tonne.
   const auto solved = [](Real massScale) {
     Cloth cloth = bentChain();
-    for (Real& m : cloth.state.mass) m *= massScale;
+    for (MassReal& m : cloth.state.mass) m = static_cast<MassReal>(m * massScale);
     for (Real& w : cloth.state.inverseMass) w /= massScale;
     SolverScratch scratch;
     lines::build(cloth, scratch, 1);

@@ -134,11 +134,14 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
     s.position = tuples<sim::Vec3>(reader, "positions", 3, "[x, y, z], finite", vec3);
     s.previousPosition = tuples<sim::Vec3>(reader, "previousPositions", 3, "[x, y, z], finite", vec3);
     if (reader.has("velocities")) s.velocity = tuples<sim::Vec3>(reader, "velocities", 3, "[x, y, z], finite", vec3);
-    s.mass = tuples<double>(reader, "masses", 1, "a positive mass in kg", [](const json& m) -> std::optional<double> {
-      const double v = m.get<double>();
-      if (!(v > 0.0) || !std::isfinite(1.0 / v) || !std::isfinite(v)) return std::nullopt;
-      return v;
-    });
+    s.mass = tuples<sim::MassReal>(reader, "masses", 1, "a positive mass in kg, at most 3.4e38",
+                                   [](const json& m) -> std::optional<sim::MassReal> {
+                                     try {
+                                       return sim::toMass(m.get<double>());
+                                     } catch (const std::invalid_argument&) {
+                                       return std::nullopt;  // not one a float holds
+                                     }
+                                   });
     s.pinned.assign(n, 0);
     for (std::uint32_t p : tuples<std::uint32_t>(reader, "pinned", 1, particle, index)) s.pinned[p] = 1;
     s.inverseMass.assign(n, 0.0);

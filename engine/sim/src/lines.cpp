@@ -135,7 +135,7 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<Line,
   using Row = SolverScratch::StiffRows;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
-  const Real* mass = s.mass.data();
+  const MassReal* mass = s.mass.data();
   const std::size_t links = n - 1;
   // Gathered first: each link's direction, value and geometric stiffness, each particle's mass.
   // Each line's system is solved in units of its first particle's mass (K / s, alpha~ s, l / s,
@@ -296,7 +296,7 @@ void inLanes(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch
 // most. (hang2 256: most rows are below it, every column above; the strains it reaches do not
 // change. Rest lengths stand in for lengths.)
 bool needsFullStep(const SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, std::size_t l,
-                   const Real* mass, Real ratio) {
+                   const MassReal* mass, Real ratio) {
   const DistanceConstraint* link = stretch + lines.firstLink(l);
   const float* tension = lines.tension.data() + lines.start[l];
   for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {

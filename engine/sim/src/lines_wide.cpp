@@ -46,7 +46,7 @@ std::size_t particleOf(const DistanceConstraint* link, std::size_t k) { return k
 }  // namespace
 
 void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const double* position,
-                           const double* inverseMass, const double* mass, const DistanceConstraint* first,
+                           const double* inverseMass, const float* mass, const DistanceConstraint* first,
                            const DistanceConstraint* const* lineLinks, const double* const* lambda,
                            const float* const* tension, const double* perUnitMass, double alphaTilde) {
   const std::size_t links = n - 1;
@@ -57,8 +57,8 @@ void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const 
     const std::size_t at = particleOf(first, k);
     const __m256d wLow = _mm256_loadu_pd(inverseMass + at), wHigh = _mm256_loadu_pd(inverseMass + at + 4);
     // (StiffRows: v[0] and v[1] hold the particle's mass and whether it moves until the solve.)
-    _mm256_storeu_ps(r.v[0], toFloats(_mm256_mul_pd(_mm256_loadu_pd(mass + at), scaleLow),
-                                      _mm256_mul_pd(_mm256_loadu_pd(mass + at + 4), scaleHigh)));
+    _mm256_storeu_ps(r.v[0], toFloats(_mm256_mul_pd(_mm256_cvtps_pd(_mm_loadu_ps(mass + at)), scaleLow),
+                                      _mm256_mul_pd(_mm256_cvtps_pd(_mm_loadu_ps(mass + at + 4)), scaleHigh)));
     _mm256_storeu_ps(
         r.v[1], toFloats(ones(_mm256_cmp_pd(wLow, zero, _CMP_GT_OQ)), ones(_mm256_cmp_pd(wHigh, zero, _CMP_GT_OQ))));
     if (k == links) {
@@ -143,7 +143,7 @@ void scatterConsecutiveWide(const SolverScratch::StiffRows* rows, std::size_t n,
 }
 #else
 // Not built for AVX (not an x86 machine): never called, as the CPU check says no.
-void gatherConsecutiveWide(SolverScratch::StiffRows*, std::size_t, const double*, const double*, const double*,
+void gatherConsecutiveWide(SolverScratch::StiffRows*, std::size_t, const double*, const double*, const float*,
                            const DistanceConstraint*, const DistanceConstraint* const*, const double* const*,
                            const float* const*, const double*, double) {}
 void scatterConsecutiveWide(const SolverScratch::StiffRows*, std::size_t, double*, const double*,

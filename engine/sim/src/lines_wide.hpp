@@ -17,7 +17,7 @@ void solveStiffLanesWide(SolverScratch::StiffRows* rows, std::size_t n, const fl
 // columns, say), position holding x, y, z per particle: the same rows[0, n), bit for bit. links
 // (for the rest lengths), lambda (null entries without XPBD) and tension: each line's.
 void gatherConsecutiveWide(SolverScratch::StiffRows* rows, std::size_t n, const double* position,
-                           const double* inverseMass, const double* mass, const DistanceConstraint* first,
+                           const double* inverseMass, const float* mass, const DistanceConstraint* first,
                            const DistanceConstraint* const* links, const double* const* lambda,
                            const float* const* tension, const double* perUnitMass, double alphaTilde);
 // ... and its scatter of the moves (the multipliers are the caller's): each particle free to move

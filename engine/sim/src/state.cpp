@@ -1,6 +1,18 @@
 #include "drape/sim/state.hpp"
 
+#include <limits>
+#include <stdexcept>
+
 namespace drape::sim {
+
+MassReal toMass(Real mass) {
+  if (!(mass > 0.0 && mass <= static_cast<Real>(std::numeric_limits<MassReal>::max()))) {
+    throw std::invalid_argument("a particle's mass must be a positive finite number of kilograms, at most 3.4e38");
+  }
+  const auto kept = static_cast<MassReal>(mass);
+  if (kept == 0.0f) throw std::invalid_argument("a particle's mass must be at least 1.4e-45 kg");
+  return kept;
+}
 
 std::vector<SolverScratch::Tethers::Tether> SolverScratch::Tethers::list() const {
   std::vector<Tether> tethers;

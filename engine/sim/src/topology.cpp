@@ -173,6 +173,23 @@ void sever(Topology& topology, std::uint32_t t, int edge) {
 }
 
 // Gives every fan of triangles around each touched particle but the first a particle of its own.
+// About `wanted` kilograms taken from `left` (wanted > 0): the share, with what is left in `left`,
+// the two adding up to what `left` was exactly. Where the share is at least half of left, left -
+// share is exact (Sterbenz); else left - share rounded is at least half of left, and left minus
+// that is exact. A share of all or more of it is cut to half.
+MassReal takeShare(MassReal& left, Real wanted) {
+  MassReal share = static_cast<MassReal>(wanted);
+  if (!(share < left)) share = 0.5f * left;
+  if (share >= 0.5f * left) {
+    left -= share;
+    return share;
+  }
+  const MassReal rest = left - share;
+  share = left - rest;
+  left = rest;
+  return share;
+}
+
 void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_t budget,
                     std::vector<ParticleSplit>& splits) {
   ClothRest& rest = cloth.rest;
@@ -225,12 +242,13 @@ void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_
       a += total > 0.0 ? 1e-6 * total : 1.0;
       weights += a;
     }
-    const Real mass = s.mass[v];
-    Real given = 0.0;
+    // Each copy's share is taken from what v has left, so that what v keeps and the share add up
+    // to what it had exactly, in single precision (MassReal): tearing neither makes nor loses mass.
+    MassReal left = s.mass[v];
     for (int g = 1; g < groups && budget > 0; ++g, --budget) {
       const auto copy = static_cast<ParticleIndex>(rest.particleCount());
-      const Real share = mass * area[static_cast<std::size_t>(g)] / weights;
-      given += share;
+      const MassReal share =
+          takeShare(left, static_cast<Real>(s.mass[v]) * area[static_cast<std::size_t>(g)] / weights);
       rest.restPositions.push_back(rest.restPositions[v]);
       s.position.push_back(s.position[v]);
       s.previousPosition.push_back(s.previousPosition[v]);
@@ -243,7 +261,7 @@ void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_
       }
       splits.push_back({v, copy});
     }
-    s.mass[v] = mass - given;
+    s.mass[v] = left;
     if (s.inverseMass[v] > 0.0) s.inverseMass[v] = 1.0 / s.mass[v];
   }
 }

@@ -144,7 +144,7 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
   const std::size_t n = cloth.rest.particleCount();
   ParticleState& s = cloth.state;
   s.position = cloth.rest.restPositions;
-  s.mass.assign(n, settings.mass / static_cast<Real>(n));
+  s.mass.assign(n, toMass(settings.mass / static_cast<Real>(n)));
   if (settings.outline) {
     // By area: a third of each triangle's area to each of its corners, so the border is lighter.
     std::vector<Real> area(n, 0.0);
@@ -155,9 +155,9 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
       for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
       total += a;
     }
-    for (std::size_t i = 0; i < n; ++i) s.mass[i] = settings.mass * area[i] / total;
+    for (std::size_t i = 0; i < n; ++i) s.mass[i] = toMass(settings.mass * area[i] / total);
   }
-  for (const ParticleMass& m : settings.masses) s.mass[cloth.rest.index(m.column, m.row)] = m.mass;
+  for (const ParticleMass& m : settings.masses) s.mass[cloth.rest.index(m.column, m.row)] = toMass(m.mass);
   s.inverseMass.resize(n);
   for (std::size_t i = 0; i < n; ++i) s.inverseMass[i] = 1.0 / s.mass[i];
   s.pinned.assign(n, 0);
@@ -937,8 +937,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
       require(finite(cloth.rest.restPositions[i]) && finite(s.position[i]) && finite(s.previousPosition[i]) &&
                   (s.velocity.empty() || finite(s.velocity[i])),
               "a cloth has a position that is not finite");
-      require(finite(s.mass[i]) && s.mass[i] > 0.0 && std::isfinite(1.0 / s.mass[i]),
-              "a particle's mass must be positive");
+      require(std::isfinite(s.mass[i]) && s.mass[i] > 0.0f, "a particle's mass must be positive");
     }
     for (const glm::uvec3& t : cloth.rest.triangles) {
       require(t.x < n && t.y < n && t.z < n, "a triangle names a particle the cloth does not have");

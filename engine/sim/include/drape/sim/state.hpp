@@ -16,9 +16,13 @@ struct ParticleState {
   std::vector<Vec3> previousPosition;  // m, position one substep ago (Verlet's velocity-less memory)
   std::vector<Vec3> velocity;          // m/s, force model only; empty in the position model
   std::vector<Real> inverseMass;       // 1/kg; 0 for a pinned or held particle, which no force or constraint moves
-  std::vector<Real> mass;              // kg, of every particle, pinned or not
+  std::vector<MassReal> mass;          // kg, of every particle, pinned or not (toMass)
   std::vector<std::uint8_t> pinned;    // 1: pinned (stays where it is until unpinned)
 };
+
+// A mass as the engine keeps it (MassReal). Throws std::invalid_argument where `mass` is not a
+// positive finite number that single precision holds (at most 3.4e38 kg, not rounding to 0).
+MassReal toMass(Real mass);
 
 }  // namespace drape::sim
 

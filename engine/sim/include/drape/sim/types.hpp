@@ -21,6 +21,9 @@ using Vec3 = glm::vec<3, Real>;
 // far below any strain the solver leaves, and saves 4 bytes on each of the several rest lengths a
 // particle has.
 using RestReal = float;
+// Particle masses too: they are parameters, never integrated, rounded once by 6e-8 of themselves
+// (a tear shares a particle's mass out exactly, topology.cpp). Inverse masses stay in double.
+using MassReal = float;
 // A particle is an index into its cloth's arrays, never a pointer.
 using ParticleIndex = std::uint32_t;
 
