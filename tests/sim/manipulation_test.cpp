@@ -74,6 +74,16 @@ TEST(Finger, HoldsEveryParticleWithinItsRadiusAndCarriesThemRigidly) {
   EXPECT_FALSE(world.hasStage(Stage::fingers));
 }
 
+TEST(Finger, AClothNoFingerHasTouchedKeepsNoHeldFlags) {
+  // Which particles a finger holds is a byte a particle, kept from the first press on.
+  World world(flatSheet(11));
+  const std::size_t untouched = world.memoryUse().solver;
+  ASSERT_GT(world.pressFinger(1, Vec3{0.5, 0.0, 0.5}, 0.15), 0);
+  EXPECT_EQ(world.memoryUse().solver, untouched + 121);
+  world.releaseFinger(1);
+  EXPECT_GT(world.pressFinger(2, Vec3{0.5, 0.0, 0.5}, 0.15), 0);  // and they were let go
+}
+
 TEST(Finger, ReleasedParticlesKeepTheFingersVelocity) {
   // One free particle, no gravity: carried at 2 m/s, then let go, it flies on at 2 m/s.
   WorldSettings settings = test::singleParticle(Vec3{0.0});

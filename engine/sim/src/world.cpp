@@ -200,10 +200,7 @@ World::World(WorldSettings settings)
   require(particleCount() <= static_cast<std::size_t>(kMaxParticles), "too many particles");
   scratch_.resize(cloths_.size());
   held_.resize(cloths_.size());
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    held_[c].assign(cloths_[c].state.position.size(), 0);
-    buildTethers(c);
-  }
+  for (std::size_t c = 0; c < cloths_.size(); ++c) buildTethers(c);
   for (const ColliderSettings& collider : settings_.colliders) colliders_.emplace_back(collider);
   buildPipeline();
 }
@@ -659,6 +656,7 @@ void World::grab(Finger& finger, std::size_t c, ParticleIndex nearest) {
   ParticleState& s = cloth.state;
   const Real r2 = finger.radius * finger.radius;
   const std::uint32_t piece = cloth.pieceOf(nearest);
+  if (held_[c].empty()) held_[c].assign(s.position.size(), 0);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
     const Vec3 offset = s.position[i] - finger.position;
     if (held_[c][i] || cloth.pieceOf(i) != piece || glm::dot(offset, offset) > r2) continue;
@@ -682,7 +680,7 @@ int World::pressFinger(int id, Vec3 point, Real radius) {
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       const Vec3 d = s.position[i] - point;
       const Real d2 = glm::dot(d, d);
-      if (held_[c][i] || d2 > best) continue;
+      if (isHeld(c, i) || d2 > best) continue;
       best = d2;
       nearest = {{c, static_cast<ParticleIndex>(i)}};
     }
@@ -703,7 +701,7 @@ std::optional<Vec3> World::pressFingerAlongRay(int id, Vec3 origin, Vec3 directi
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     const ParticleState& s = cloths_[c].state;
     for (std::size_t i = 0; i < s.position.size(); ++i) {
-      if (held_[c][i]) continue;
+      if (isHeld(c, i)) continue;
       const Vec3 d = s.position[i] - origin;
       const Real t = glm::dot(d, unit);
       if (t <= 0.0 || glm::dot(d, d) - t * t > radius * radius) continue;
@@ -759,7 +757,7 @@ int World::unpin(Vec3 point, Real radius) {
     ParticleState& s = cloths_[c].state;
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       const Vec3 d = s.position[i] - point;
-      if (!s.pinned[i] || held_[c][i] || glm::dot(d, d) > radius * radius) continue;
+      if (!s.pinned[i] || isHeld(c, i) || glm::dot(d, d) > radius * radius) continue;
       s.pinned[i] = 0;
       s.inverseMass[i] = 1.0 / s.mass[i];
       ++freed;
@@ -797,10 +795,10 @@ std::size_t World::particleCount() const {
 void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>& splits) {
   Cloth& cloth = cloths_[c];
   const std::size_t n = cloth.state.position.size();
-  held_[c].resize(n, 0);
+  if (!held_[c].empty()) held_[c].resize(n, 0);
   // A copy of a held particle stays in the same finger's grip.
   for (const ParticleSplit& split : splits) {
-    if (!held_[c][split.original]) continue;
+    if (!isHeld(c, split.original)) continue;
     for (Finger& f : fingers_) {
       for (std::size_t g = 0; g < f.grips.size(); ++g) {
         if (f.grips[g].cloth != static_cast<int>(c) || f.grips[g].particle != split.original) continue;
@@ -911,7 +909,7 @@ int World::addCloth(const ClothSettings& settings) {
   settings_.cloths.push_back(settings);
   const std::size_t c = cloths_.size() - 1;
   scratch_.emplace_back();
-  held_.emplace_back(cloths_[c].state.position.size(), 0);
+  held_.emplace_back();
   buildTethers(c);
   buildPipeline();
   if (historyStarted_) {
@@ -970,7 +968,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
       if (!s.velocity.empty()) s.velocity[i] = Vec3{0.0};
     }
     cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
-    held_.emplace_back(s.position.size(), 0);
+    held_.emplace_back();
     buildTethers(c);
     if (settings_.solver.model == Model::force)
       force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), scratch_[c]);

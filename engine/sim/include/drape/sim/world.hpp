@@ -214,7 +214,12 @@ class World {
   GuardCopy guardCopy_ = GuardCopy::before;
   std::vector<std::vector<Vec3>> lastGood_;  // per cloth, unless guardCopy_ is none
   std::vector<Finger> fingers_;
-  std::vector<std::vector<std::uint8_t>> held_;  // per cloth and particle: 1 while a finger holds it
+  // Per cloth and particle: 1 while a finger holds it. Empty until a finger first holds some of the
+  // cloth: a scene no finger touches does not pay a byte a particle for it.
+  std::vector<std::vector<std::uint8_t>> held_;
+  bool isHeld(std::size_t cloth, std::size_t particle) const {
+    return !held_[cloth].empty() && held_[cloth][particle] != 0;
+  }
   std::unique_ptr<Workers> workers_;
 };
 
