@@ -309,7 +309,7 @@ bool cpuHasAvx() {
 
 void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
   const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
-  const std::size_t n = cloth.rest.restPositions.size();
+  const std::size_t n = cloth.rest.particleCount();
   scratch.looseStretch.clear();
   std::size_t longest = 0;
   for (int family = 0; family < 2; ++family) {
@@ -321,7 +321,7 @@ void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
     std::vector<std::array<std::int64_t, 2>> next(n, {-1, -1});  // the constraints at each particle
     for (std::uint32_t k = 0; k < stretch.size(); ++k) {
       const DistanceConstraint& c = stretch[k];
-      const Vec3 d = glm::abs(cloth.rest.restPositions[c.b] - cloth.rest.restPositions[c.a]);
+      const Vec3 d = glm::abs(cloth.rest.restPosition(c.b) - cloth.rest.restPosition(c.a));
       const bool alongX = d.x >= std::max(d.y, d.z);
       if (alongX != (family == 0)) continue;
       const std::uint32_t ra = findRoot(parent, c.a), rb = findRoot(parent, c.b);
