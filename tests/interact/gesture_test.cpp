@@ -95,8 +95,9 @@ Real totalMass(const sim::World& world) {
 Real triangleArea(const sim::Cloth& cloth) {
   Real area = 0.0;
   for (const glm::uvec3& t : cloth.rest.triangles) {
-    const auto& r = cloth.rest.restPositions;
-    area += 0.5 * glm::length(glm::cross(r[t[1]] - r[t[0]], r[t[2]] - r[t[0]]));
+    const sim::ClothRest& r = cloth.rest;
+    area += 0.5 * glm::length(glm::cross(r.restPosition(t[1]) - r.restPosition(t[0]),
+                                         r.restPosition(t[2]) - r.restPosition(t[0])));
   }
   return area;
 }

@@ -1,14 +1,21 @@
 // Scene files: the shipped scenes, overrides, and what the reader refuses.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
 #include <nlohmann/json.hpp>
 
 #include "drape/scene/error.hpp"
+#include "drape/scene/output.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/scene/snapshot.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 
@@ -395,6 +402,53 @@ TEST(Scene, SwitchingToTheForceModelTakesTheSubstepsItsSpringsNeed) {
   // The position model keeps the scene's substeps.
   EXPECT_EQ(withModel(scene, sim::Model::position, sim::Integrator::verlet).world.solver.substeps,
             scene.world.solver.substeps);
+}
+
+TEST(Snapshot, AClothFarFromTheOriginComesBackOffsetForOffsetAndRunsOnBitForBit) {
+  // hang2-tear 7 km out: torn (tearing appends copies of particles), and untorn with tethers (they
+  // are measured between rest positions when the world is planned, so a change in the offsets would
+  // show in the steps after loading).
+  const std::string far = "cloths.0.origin=[-7123.456789,1.5,4987.654321]";
+  for (const std::vector<std::string>& overrides : {std::vector<std::string>{far, "tearing.threshold=1.03"},
+                                                    std::vector<std::string>{far, "solver.tethers=true"}}) {
+    SCOPED_TRACE(overrides[1]);
+    const Scene scene = loadScene(resolveScenePath("hang2-tear"), overrides);
+    sim::World world(scene.world);
+    ASSERT_EQ(world.run(40), sim::StepStatus::ok);
+    const sim::ClothRest& rest = world.cloths()[0].rest;
+    EXPECT_EQ(rest.particleCount() > 64u * 64u, overrides[1] == "tearing.threshold=1.03");  // torn, or not
+    const std::filesystem::path file =
+        std::filesystem::temp_directory_path() / ("drape-far-" + std::to_string(::getpid()) + ".drape.json");
+    writeFileAtomically(file, snapshotDocument(scene, world).dump());
+    const Snapshot snapshot = loadSnapshot(file);
+    std::filesystem::remove(file);
+    ASSERT_EQ(snapshot.cloths.size(), 1u);
+    const sim::ClothRest& back = snapshot.cloths[0].rest;
+    EXPECT_EQ(back.restOrigin, rest.restOrigin);
+    EXPECT_EQ(back.restOffsets, rest.restOffsets);
+    sim::World loaded = makeWorld(snapshot);
+    for (int step = 0; step < 20; ++step) {
+      ASSERT_EQ(world.step(), sim::StepStatus::ok);
+      ASSERT_EQ(loaded.step(), sim::StepStatus::ok);
+    }
+    EXPECT_TRUE(loaded.cloths()[0].state.position == world.cloths()[0].state.position);
+    EXPECT_EQ(loaded.cloths()[0].pieceCount, world.cloths()[0].pieceCount);
+  }
+}
+
+TEST(Snapshot, ARestPositionSinglePrecisionCannotHoldIsRefusedByName) {
+  const Scene scene = loadScene(resolveScenePath("hang2-tear"),
+                                {"cloths.0.grid.columns=4", "cloths.0.grid.rows=4", "cloths.0.pins.1.particle=[3,0]"});
+  const sim::World world(scene.world);
+  json document = snapshotDocument(scene, world);
+  document["cloths"][0]["restPositions"][5][0] = 1e39;
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("drape-wide-" + std::to_string(::getpid()) + ".drape.json");
+  writeFileAtomically(file, document.dump());
+  const std::string error = errorOf([&] { loadSnapshot(file); });
+  std::filesystem::remove(file);
+  EXPECT_NE(error.find("cloths.0.restPositions"), std::string::npos) << error;
+  EXPECT_NE(error.find("rest position 5"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -225,10 +225,11 @@ TEST(Tunnelling, AFastDropDoesNotPassThroughAMeshShell) {
 Real closestNonNeighbours(const Cloth& cloth, Real restApart) {
   Real closest = 1e9;
   const auto& x = cloth.state.position;
-  const auto& r = cloth.rest.restPositions;
+  const ClothRest& r = cloth.rest;
   for (std::size_t i = 0; i < x.size(); ++i) {
     for (std::size_t j = i + 1; j < x.size(); ++j) {
-      if (glm::length(r[i] - r[j]) > restApart) closest = std::min(closest, glm::length(x[i] - x[j]));
+      if (glm::length(r.restPosition(i) - r.restPosition(j)) > restApart)
+        closest = std::min(closest, glm::length(x[i] - x[j]));
     }
   }
   return closest;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -24,9 +25,7 @@ TEST(Lattice, ConstraintCountsFollowTheSeedsLattice) {
 TEST(Lattice, RestLengthsAreTheSpacing) {
   // 5 columns over 1 m: 0.25 m along x; 4 rows over 0.6 m: 0.2 m along z.
   const ClothRest rest = buildLattice({5, 4, 1.0, 0.6, Vec3{0.0}, LatticePlane::xz});
-  const auto alongX = [&](const DistanceConstraint& c) {
-    return rest.restPositions[c.a].z == rest.restPositions[c.b].z;
-  };
+  const auto alongX = [&](const DistanceConstraint& c) { return rest.restPosition(c.a).z == rest.restPosition(c.b).z; };
   // Rest lengths are single precision (RestReal): the nearest float, give or take an ulp or two.
   for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) {
     EXPECT_FLOAT_EQ(c.restLength, alongX(c) ? 0.25f : 0.2f);
@@ -43,7 +42,8 @@ TEST(Lattice, RestLengthsSinglePrecisionCannotHoldAreRefused) {
   for (const Real bad : {-1.0, 1e39, 1e-50, std::numeric_limits<Real>::infinity(), std::nan("")}) {
     EXPECT_THROW(toRestLength(bad), std::invalid_argument) << bad;
   }
-  // A lattice too large or too fine for them is refused, not built with infinite or zero lengths.
+  // A lattice too large or too fine for them is refused, not built with infinite or zero lengths (too
+  // fine, its particles' single-precision rest positions would coincide).
   EXPECT_THROW(buildLattice({3, 3, 1e39, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
   EXPECT_THROW(buildLattice({3, 3, 1e-100, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
 }
@@ -65,14 +65,14 @@ TEST(Lattice, IndexIsRowMajorAndPlanesPointTheRightWay) {
   const Vec3 origin{1.0, 2.0, 3.0};
   const ClothRest flat = buildLattice({3, 2, 2.0, 1.0, origin, LatticePlane::xz});
   EXPECT_EQ(flat.index(2, 1), 5u);
-  EXPECT_EQ(flat.restPositions[flat.index(2, 1)], (Vec3{3.0, 2.0, 4.0}));
+  EXPECT_EQ(flat.restPosition(flat.index(2, 1)), (Vec3{3.0, 2.0, 4.0}));
   const ClothRest hanging = buildLattice({3, 2, 2.0, 1.0, origin, LatticePlane::xy});
-  EXPECT_EQ(hanging.restPositions[hanging.index(2, 1)], (Vec3{3.0, 1.0, 3.0}));
+  EXPECT_EQ(hanging.restPosition(hanging.index(2, 1)), (Vec3{3.0, 1.0, 3.0}));
   // Front faces: +y for a flat sheet, +z for a hanging one.
   for (const auto& [rest, up] : {std::pair{&flat, Vec3{0, 1, 0}}, std::pair{&hanging, Vec3{0, 0, 1}}}) {
     for (const glm::uvec3& t : rest->triangles) {
-      const Vec3 n = glm::cross(rest->restPositions[t.y] - rest->restPositions[t.x],
-                                rest->restPositions[t.z] - rest->restPositions[t.x]);
+      const Vec3 n = glm::cross(rest->restPosition(t.y) - rest->restPosition(t.x),
+                                rest->restPosition(t.z) - rest->restPosition(t.x));
       EXPECT_GT(glm::dot(n, up), 0.0);
     }
   }
@@ -101,6 +101,59 @@ TEST(Lattice, RejectsImpossibleSpecs) {
   EXPECT_THROW(buildLattice({4, 4, 0.0, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
   EXPECT_THROW(buildLattice({5000, 4, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
   EXPECT_THROW(buildLattice({4000, 4000, 1.0, 1.0, Vec3{0.0}, LatticePlane::xz}), std::invalid_argument);
+}
+
+TEST(RestPositions, AreHeldToTheClothsSizeWhereverItIs) {
+  // 101 columns over 1 m, 3 km from the world's origin. Offsets from the first particle are within
+  // 2^-24 m of the lattice (floats of at most 1 m); positions themselves in single precision would
+  // be up to 1.2e-4 m off, rest lengths up to 2 % of the spacing.
+  const Vec3 far{3000.1, -2000.2, 1000.3};
+  const Real dx = 1.0 / 100.0;
+  const ClothRest rest = buildLattice({101, 3, 1.0, 0.02, far, LatticePlane::xz});
+  EXPECT_EQ(rest.restOrigin, far);
+  EXPECT_EQ(rest.restPosition(0), far);
+  for (int column = 0; column < 101; ++column) {
+    const Vec3 expected = far + Vec3{dx * column, 0.0, 0.0};
+    EXPECT_LE(glm::length(rest.restPosition(rest.index(column, 0)) - expected), std::ldexp(1.0, -24)) << column;
+  }
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) {
+    // The rest length is measured between the rounded positions: the spacing within two roundings.
+    EXPECT_NEAR(c.restLength, dx, 2.0 * std::ldexp(1.0, -24) + 1e-9);
+    EXPECT_EQ(c.restLength, toRestLength(glm::length(rest.restPosition(c.b) - rest.restPosition(c.a))));
+  }
+}
+
+TEST(RestPositions, SetAgainFromTheirOwnDoublesGiveBackTheSameOffsets) {
+  // What a snapshot does: writes restPosition(i) as doubles and sets them again. The first
+  // particle's offset is 0, so the origin comes back exactly, and with it every offset.
+  for (const Vec3 origin : {Vec3{0.0}, Vec3{-7123.456789, 1.5, 4987.654321}, Vec3{1e-3, 2.0 / 3.0, -1e4 / 7.0}}) {
+    ClothRest rest = buildLattice({64, 33, 1.7, 0.9, origin, LatticePlane::xy});
+    rest.duplicateRestPosition(rest.index(40, 20));  // as tearing does
+    EXPECT_EQ(rest.particleCount(), 64u * 33u + 1u);
+    EXPECT_EQ(rest.restPosition(rest.particleCount() - 1), rest.restPosition(rest.index(40, 20)));
+    std::vector<Vec3> written(rest.particleCount());
+    for (std::size_t i = 0; i < written.size(); ++i) written[i] = rest.restPosition(i);
+    ClothRest back;
+    back.setRestPositions(written);
+    EXPECT_EQ(back.restOrigin, rest.restOrigin);
+    EXPECT_EQ(back.restOffsets, rest.restOffsets);
+  }
+}
+
+TEST(RestPositions, OffsetsSinglePrecisionCannotHoldAreRefused) {
+  ClothRest rest;
+  rest.setRestPositions({});
+  EXPECT_EQ(rest.particleCount(), 0u);
+  const Real inf = std::numeric_limits<Real>::infinity();
+  for (const Vec3 bad :
+       {Vec3{1e39, 0.0, 0.0}, Vec3{0.0, -4e38, 0.0}, Vec3{0.0, 0.0, inf}, Vec3{std::nan(""), 0.0, 0.0}}) {
+    EXPECT_THROW(rest.setRestPositions({Vec3{0.0}, bad}), std::invalid_argument)
+        << bad.x << " " << bad.y << " " << bad.z;
+  }
+  EXPECT_THROW(rest.setRestPositions({Vec3{inf, 0.0, 0.0}}), std::invalid_argument);  // the origin too
+  // Far out, but within float range of the first particle.
+  rest.setRestPositions({Vec3{1e38, 0.0, 0.0}, Vec3{-1e38, 0.0, 0.0}});
+  EXPECT_EQ(rest.restOffsets[1].x, static_cast<float>(-2e38));
 }
 
 }  // namespace

@@ -44,7 +44,7 @@ Real worstTriangleStretch(const Cloth& cloth) {
   for (const glm::uvec3& t : cloth.rest.triangles) {
     for (int k = 0; k < 3; ++k) {
       const ParticleIndex a = t[k], b = t[(k + 1) % 3];
-      const Real rest = glm::length(cloth.rest.restPositions[b] - cloth.rest.restPositions[a]);
+      const Real rest = glm::length(cloth.rest.restPosition(b) - cloth.rest.restPosition(a));
       worst = std::max(worst, glm::length(cloth.state.position[b] - cloth.state.position[a]) / rest);
     }
   }

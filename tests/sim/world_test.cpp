@@ -210,5 +210,13 @@ TEST(World, RejectsSettingsOutsideItsLimits) {
   EXPECT_THROW(World{settings}, std::invalid_argument);
 }
 
+TEST(Memory, RestPositionsTakeTwelveBytesAParticle) {
+  // Single-precision offsets (ClothRest); the rest count is them and the triangles.
+  const World world(test::hangingSheet(20, 2, 1));
+  const ClothRest& rest = world.cloths()[0].rest;
+  EXPECT_EQ(rest.restOffsets.capacity(), 400u);
+  EXPECT_EQ(world.memoryUse().rest, 400u * 12u + rest.triangles.capacity() * sizeof(glm::uvec3));
+}
+
 }  // namespace
 }  // namespace drape::sim

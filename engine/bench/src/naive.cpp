@@ -14,7 +14,10 @@ NaiveCloth::NaiveCloth(const sim::WorldSettings& world, int iterations)
   const sim::ClothSettings& cloth = world.cloths.at(0);
   const sim::ClothRest rest = sim::buildLattice(cloth.lattice);
   const sim::Real particleMass = cloth.mass / static_cast<sim::Real>(rest.particleCount());
-  for (const sim::Vec3& x : rest.restPositions) particles_.push_back({x, x, 1.0 / particleMass});
+  for (std::size_t i = 0; i < rest.particleCount(); ++i) {
+    const sim::Vec3 x = rest.restPosition(i);
+    particles_.push_back({x, x, 1.0 / particleMass});
+  }
   for (sim::ConstraintKind kind : sim::kConstraintKinds) {
     const sim::Real stiffness = cloth.material(kind).stiffness;
     if (stiffness == 0.0) continue;

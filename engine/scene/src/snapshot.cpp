@@ -52,7 +52,11 @@ json snapshotDocument(const Scene& scene, const sim::World& world) {
   json cloths = json::array();
   for (const sim::Cloth& cloth : world.cloths()) {
     json c;
-    c["restPositions"] = vectors(cloth.rest.restPositions);
+    // In double, as the engine's origin plus offset: set again, they give back the same origin (the
+    // first particle's, offset 0) and offsets, bit for bit (tested).
+    std::vector<sim::Vec3> restPositions(cloth.rest.particleCount());
+    for (std::size_t i = 0; i < restPositions.size(); ++i) restPositions[i] = cloth.rest.restPosition(i);
+    c["restPositions"] = vectors(restPositions);
     json triangles = json::array();
     for (const glm::uvec3& t : cloth.rest.triangles) triangles.push_back({t.x, t.y, t.z});
     c["triangles"] = std::move(triangles);
@@ -102,8 +106,12 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
     }
     cloth.settings.pins.clear();
     cloth.settings.masses.clear();
-    cloth.rest.restPositions = tuples<sim::Vec3>(reader, "restPositions", 3, "[x, y, z], finite", vec3);
-    const std::size_t n = cloth.rest.restPositions.size();
+    try {
+      cloth.rest.setRestPositions(tuples<sim::Vec3>(reader, "restPositions", 3, "[x, y, z], finite", vec3));
+    } catch (const std::invalid_argument& error) {
+      throw InputError(source + ": " + reader.pathOf("restPositions") + ": " + error.what());
+    }
+    const std::size_t n = cloth.rest.particleCount();
     const auto index = [n](const json& v) -> std::optional<std::uint32_t> {
       if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() >= static_cast<long long>(n)) {
         return std::nullopt;

@@ -7,7 +7,7 @@ namespace drape::sim::batches {
 
 Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source) {
   Batches result;
-  const std::size_t n = rest.restPositions.size();
+  const std::size_t n = rest.particleCount();
   std::vector<std::uint64_t> used(n);
   std::vector<std::uint8_t> colourOf;
   std::vector<DistanceConstraint> sorted;

@@ -4,6 +4,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -37,10 +38,29 @@ RestReal toRestLength(Real length) {
   return rest;
 }
 
+void ClothRest::setRestPositions(const std::vector<Vec3>& positions) {
+  const Vec3 origin = positions.empty() ? Vec3{0.0} : positions.front();
+  std::vector<glm::vec3> offsets(positions.size());
+  constexpr auto kRange = static_cast<Real>(std::numeric_limits<float>::max());
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const Vec3 offset = positions[i] - origin;
+    // Written out so that a NaN fails it too.
+    if (!(std::abs(offset.x) <= kRange && std::abs(offset.y) <= kRange && std::abs(offset.z) <= kRange)) {
+      throw std::invalid_argument("rest position " + std::to_string(i) +
+                                  " is not finite or lies beyond 3.4e38 m of the cloth's first particle");
+    }
+    offsets[i] = glm::vec3(offset);
+  }
+  restOrigin = origin;
+  restOffsets = std::move(offsets);
+}
+
 namespace {
 
 void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
-  const RestReal restLength = toRestLength(glm::length(rest.restPositions[b] - rest.restPositions[a]));
+  const RestReal restLength = toRestLength(glm::length(rest.restPosition(b) - rest.restPosition(a)));
+  // Lattice points are apart: they coincide only where single precision could not hold the spacing.
+  if (restLength == 0.0f) throw std::invalid_argument("lattice spacing is too fine for single precision");
   rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
 }
 
@@ -65,13 +85,17 @@ ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
   const Vec3 along{1.0, 0.0, 0.0};
   const Vec3 down = spec.plane == LatticePlane::xz ? Vec3{0.0, 0.0, 1.0} : Vec3{0.0, -1.0, 0.0};
 
-  rest.restPositions.reserve(static_cast<std::size_t>(spec.columns) * spec.rows);
+  std::vector<Vec3> positions;
+  positions.reserve(static_cast<std::size_t>(spec.columns) * spec.rows);
   for (int row = 0; row < spec.rows; ++row) {
     for (int column = 0; column < spec.columns; ++column) {
-      rest.restPositions.push_back(spec.origin + along * (dx * static_cast<Real>(column)) +
-                                   down * (dy * static_cast<Real>(row)));
+      positions.push_back(spec.origin + along * (dx * static_cast<Real>(column)) +
+                          down * (dy * static_cast<Real>(row)));
     }
   }
+  // Rest lengths below come from the rounded positions, so that they agree with everything else
+  // measured at rest (tethers, self-collision distances).
+  rest.setRestPositions(positions);
 
   // Triangles wound counter-clockwise when seen from +y (xz plane) or +z (xy plane).
   for (int row = 0; row + 1 < spec.rows; ++row) {

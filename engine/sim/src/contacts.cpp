@@ -239,7 +239,7 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
       if (wi + wj == 0.0) continue;
       // Particles of one cloth closer than d at rest (neighbours) keep their rest distance.
       const Real target =
-          ca == cb ? std::min(d, glm::length(cloths[ca].rest.restPositions[j] - cloths[ca].rest.restPositions[i])) : d;
+          ca == cb ? std::min(d, glm::length(cloths[ca].rest.restPosition(j) - cloths[ca].rest.restPosition(i))) : d;
       const Real distance = std::sqrt(distance2);
       if (distance >= target) continue;
       const Vec3 push = between * ((target - distance) / (distance * (wi + wj)));

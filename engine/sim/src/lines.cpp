@@ -321,7 +321,7 @@ bool cpuHasAvx() {
 
 void build(Cloth& cloth, SolverScratch& scratch, int threads) {
   std::vector<DistanceConstraint>& stretch = cloth.rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
-  const std::size_t n = cloth.rest.restPositions.size();
+  const std::size_t n = cloth.rest.particleCount();
   // The links are taken in the order of their particles, not of the array: which join a line then
   // does not depend on the order the constraints come in, so building again from the order this
   // leaves them in (a snapshot, another thread count) gives the same lines.
@@ -348,7 +348,7 @@ void build(Cloth& cloth, SolverScratch& scratch, int threads) {
     std::vector<std::array<std::int64_t, 2>> next(n, {-1, -1});  // the constraints at each particle
     for (const std::uint32_t k : byPair) {
       const DistanceConstraint& c = stretch[k];
-      const Vec3 d = glm::abs(cloth.rest.restPositions[c.b] - cloth.rest.restPositions[c.a]);
+      const Vec3 d = glm::abs(cloth.rest.restPosition(c.b) - cloth.rest.restPosition(c.a));
       const bool alongX = d.x >= std::max(d.y, d.z);
       if (alongX != (family == 0)) continue;
       const std::uint32_t ra = findRoot(parent, c.a), rb = findRoot(parent, c.b);

@@ -1543,13 +1543,15 @@ OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selec
   }
   ClothRest& rest = result.rest;
   std::vector<std::int64_t> nodeOfParticle;
+  std::vector<Vec3> positions;
   for (std::size_t v = 0; v < vertices.size(); ++v) {
     if (particleOf[v] == kNone) continue;
-    particleOf[v] = static_cast<std::int64_t>(rest.restPositions.size());
+    particleOf[v] = static_cast<std::int64_t>(positions.size());
     const glm::dvec2 p = frame.toWorld(vertices[v].position);
-    rest.restPositions.push_back(Vec3(p.x, spec.height, p.y));
+    positions.push_back(Vec3(p.x, spec.height, p.y));
     nodeOfParticle.push_back(vertices[v].node);
   }
+  rest.setRestPositions(positions);  // before the rest lengths, which come from the rounded positions
   for (Triangle& tri : triangles) {
     for (std::uint32_t& v : tri) v = static_cast<std::uint32_t>(particleOf[v]);
     rest.triangles.push_back(glm::uvec3(tri[0], tri[1], tri[2]));
@@ -1595,7 +1597,7 @@ OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selec
     return std::binary_search(sortedTriangles.begin(), sortedTriangles.end(), s);
   };
   const auto add = [&](ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
-    const RestReal restLength = toRestLength(glm::length(rest.restPositions[b] - rest.restPositions[a]));
+    const RestReal restLength = toRestLength(glm::length(rest.restPosition(b) - rest.restPosition(a)));
     // Coincident particles cannot survive the collapses; should they, a constraint without a direction is worse
     // than none.
     if (restLength > 0.0) rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});

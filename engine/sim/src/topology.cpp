@@ -39,7 +39,7 @@ struct Incidence {
 };
 
 Vec3 restCentroid(const ClothRest& rest, const Triangle& t) {
-  return (rest.restPositions[t[0]] + rest.restPositions[t[1]] + rest.restPositions[t[2]]) / 3.0;
+  return (rest.restPosition(t[0]) + rest.restPosition(t[1]) + rest.restPosition(t[2])) / 3.0;
 }
 
 void addTemplates(Topology& topology, const ClothRest& rest, const Incidence& incidence, ConstraintKind kind,
@@ -249,7 +249,7 @@ void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_
       const auto copy = static_cast<ParticleIndex>(rest.particleCount());
       const MassReal share =
           takeShare(left, static_cast<Real>(s.mass[v]) * area[static_cast<std::size_t>(g)] / weights);
-      rest.restPositions.push_back(rest.restPositions[v]);
+      rest.duplicateRestPosition(v);
       s.position.push_back(s.position[v]);
       s.previousPosition.push_back(s.previousPosition[v]);
       if (!s.velocity.empty()) s.velocity.push_back(s.velocity[v]);
@@ -285,8 +285,8 @@ void build(Cloth& cloth) {
   uses.reserve(triangles.size() * 3);
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     const Triangle& tri = triangles[t];
-    topology.triangleArea[t] = 0.5 * glm::length(glm::cross(rest.restPositions[tri[1]] - rest.restPositions[tri[0]],
-                                                            rest.restPositions[tri[2]] - rest.restPositions[tri[0]]));
+    topology.triangleArea[t] = 0.5 * glm::length(glm::cross(rest.restPosition(tri[1]) - rest.restPosition(tri[0]),
+                                                            rest.restPosition(tri[2]) - rest.restPosition(tri[0])));
     for (int k = 0; k < 3; ++k) {
       const std::uint64_t lo = std::min(tri[k], tri[(k + 1) % 3]), hi = std::max(tri[k], tri[(k + 1) % 3]);
       uses.push_back({lo << 32 | hi, t, k});
@@ -343,7 +343,7 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
   const auto severAround = [&](ParticleIndex v, Vec3 pull) {
     bool severed = false;
     const auto ahead = [&](std::uint32_t t) {
-      return glm::dot(restCentroid(rest, rest.triangles[t]) - rest.restPositions[v], pull) > 0.0;
+      return glm::dot(restCentroid(rest, rest.triangles[t]) - rest.restPosition(v), pull) > 0.0;
     };
     for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
       const int cv = cornerOf(rest.triangles[*t], v);
@@ -380,7 +380,7 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     const DistanceConstraint& c = stretch[j];
     if (near[c.a] || near[c.b]) continue;
     const std::size_t before = touched.size();
-    const Vec3 pull = rest.restPositions[c.b] - rest.restPositions[c.a];
+    const Vec3 pull = rest.restPosition(c.b) - rest.restPosition(c.a);
     if (severAround(c.a, pull) || severAround(c.b, -pull)) changed = true;
     // Mark the triangles around every particle on the new crack.
     for (std::size_t k = before; k < touched.size(); ++k) {

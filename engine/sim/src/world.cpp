@@ -143,7 +143,8 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
                                 : buildLattice(settings.lattice, selection);
   const std::size_t n = cloth.rest.particleCount();
   ParticleState& s = cloth.state;
-  s.position = cloth.rest.restPositions;
+  s.position.resize(n);
+  for (std::size_t i = 0; i < n; ++i) s.position[i] = cloth.rest.restPosition(i);
   s.mass.assign(n, toMass(settings.mass / static_cast<Real>(n)));
   if (settings.outline) {
     // By area: a third of each triangle's area to each of its corners, so the border is lighter.
@@ -219,7 +220,7 @@ void World::buildTethers(std::size_t c) {
     for (const std::size_t p : pins) {
       if (cloth.pieceOf(i) != cloth.pieceOf(p)) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
-      const RestReal length = toRestLength(glm::length(cloth.rest.restPositions[i] - cloth.rest.restPositions[p]));
+      const RestReal length = toRestLength(glm::length(cloth.rest.restPosition(i) - cloth.rest.restPosition(p)));
       tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
     }
   }
@@ -362,7 +363,7 @@ std::size_t bytes(const std::array<std::vector<T>, N>& arrays) {
 MemoryUse World::memoryUse() const {
   MemoryUse m;
   for (const Cloth& cloth : cloths_) {
-    m.rest += bytes(cloth.rest.restPositions) + bytes(cloth.rest.triangles);
+    m.rest += bytes(cloth.rest.restOffsets) + bytes(cloth.rest.triangles);
     m.constraints += bytes(cloth.rest.constraints);
     const ParticleState& s = cloth.state;
     m.state += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) +
@@ -924,7 +925,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   std::size_t particles = 0;
   for (const Cloth& cloth : cloths) {
     const ParticleState& s = cloth.state;
-    const std::size_t n = cloth.rest.restPositions.size();
+    const std::size_t n = cloth.rest.particleCount();
     particles += n;
     validateCloth(cloth.settings, settings_.solver.model);
     require(s.position.size() == n && s.previousPosition.size() == n && s.mass.size() == n &&
@@ -932,7 +933,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
                 (settings_.solver.model == Model::force ? s.velocity.size() == n : s.velocity.empty()),
             "a cloth's arrays do not all have one entry per particle");
     for (std::size_t i = 0; i < n; ++i) {
-      require(finite(cloth.rest.restPositions[i]) && finite(s.position[i]) && finite(s.previousPosition[i]) &&
+      require(finite(cloth.rest.restPosition(i)) && finite(s.position[i]) && finite(s.previousPosition[i]) &&
                   (s.velocity.empty() || finite(s.velocity[i])),
               "a cloth has a position that is not finite");
       require(std::isfinite(s.mass[i]) && s.mass[i] > 0.0f, "a particle's mass must be positive");

@@ -53,11 +53,22 @@ struct LatticeSpec {
 struct ClothRest {
   int columns = 0;
   int rows = 0;
-  std::vector<Vec3> restPositions;    // m, index = row * columns + column
-  std::vector<glm::uvec3> triangles;  // counter-clockwise seen from the front (+y or +z)
+  // Rest positions in single precision, as offsets from the cloth's own origin: 12 bytes a particle
+  // instead of 24, and rounded relative to the cloth's size (6e-8 of it), wherever the cloth is in
+  // the world. The origin is the first particle's rest position (setRestPositions), so positions
+  // written out as doubles (snapshots) and set again give back the same origin and offsets.
+  Vec3 restOrigin{0.0};                // m
+  std::vector<glm::vec3> restOffsets;  // m from restOrigin, index = row * columns + column
+  std::vector<glm::uvec3> triangles;   // counter-clockwise seen from the front (+y or +z)
   std::array<std::vector<DistanceConstraint>, kConstraintKindCount> constraints;  // by kind
 
-  std::size_t particleCount() const { return restPositions.size(); }
+  std::size_t particleCount() const { return restOffsets.size(); }
+  Vec3 restPosition(std::size_t i) const { return restOrigin + Vec3(restOffsets[i]); }  // m
+  // Sets every rest position, the first one as the origin. Throws std::invalid_argument where a
+  // position is not finite or lies beyond single precision's range (3.4e38 m) from the first.
+  void setRestPositions(const std::vector<Vec3>& positions);
+  // A new particle at particle i's rest position (tearing splits a particle into copies).
+  void duplicateRestPosition(std::size_t i) { restOffsets.push_back(glm::vec3(restOffsets[i])); }
   ParticleIndex index(int column, int row) const { return static_cast<ParticleIndex>(row * columns + column); }
   const std::vector<DistanceConstraint>& of(ConstraintKind kind) const {
     return constraints[static_cast<std::size_t>(kind)];
