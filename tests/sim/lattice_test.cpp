@@ -39,6 +39,13 @@ TEST(Lattice, RestLengthsAreTheSpacing) {
 TEST(Lattice, RestLengthsSinglePrecisionCannotHoldAreRefused) {
   EXPECT_EQ(toRestLength(0.0), 0.0f);
   EXPECT_EQ(toRestLength(0.25), 0.25f);
+  // Rounded up where asked: never below the length, and the next float at most above it.
+  EXPECT_EQ(toRestLengthAtLeast(0.25), 0.25f);
+  for (const Real length : {0.1, 1.0 / 3.0, 0.7, 123.456}) {
+    const RestReal up = toRestLengthAtLeast(length);
+    EXPECT_GE(static_cast<Real>(up), length);
+    EXPECT_LT(static_cast<Real>(std::nextafter(up, 0.0f)), length);
+  }
   for (const Real bad : {-1.0, 1e39, 1e-50, std::numeric_limits<Real>::infinity(), std::nan("")}) {
     EXPECT_THROW(toRestLength(bad), std::invalid_argument) << bad;
   }

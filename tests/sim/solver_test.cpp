@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -756,16 +757,16 @@ TEST(FastSweep, WithTheTethersBetweenTheLineStepsASweepEndsWithEveryParticleWith
     for (std::size_t i = 0; i < x.size(); ++i) {
       for (const ParticleIndex pin : pins) {
         if (i == pin) continue;
-        const Real length =
-            static_cast<RestReal>(glm::length(rest.restPosition(i) - rest.restPosition(pin)));  // the tether's
+        // The tether's length: the rest distance, rounded up to a float (World::buildTethers).
+        const Real length = toRestLengthAtLeast(glm::length(rest.restPosition(i) - rest.restPosition(pin)));
         worst = std::max(worst, glm::length(x[i] - x[pin]) / length - 1.0);
       }
     }
   }
-  // Within a float's rounding (2^-23 of the length): on the top row between the pins the two tethers'
-  // balls only touch, and with single-precision rest positions and lengths their radii can fall
-  // short of the pins' distance by a rounding, so no point is within both (6e-8 at worst here).
-  EXPECT_LT(worst, 1.2e-7);
+  // On the top row between the pins the two tethers' balls only just touch: rounded to the nearest
+  // float, their radii fell short of the pins' distance by up to 6e-8 of it, and no point was
+  // within both. Rounded up, every particle ends within both.
+  EXPECT_LT(worst, 1e-12);
   EXPECT_GT(structuralStrain(world).max, 1e-3);  // the cloth is stretched; the tethers hold it
 }
 
@@ -968,9 +969,10 @@ TEST(Tethers, TheLensIsRightWhereAParticleRestsBeyondAPin) {
   // Pins at (0, 0, 0) and (1, 0, 0); particle (0, 1) rests at (-0.5, 0, 0.8), beyond the first pin
   // along their axis: the circle where its two tether spheres meet lies on that side of the pin.
   const WorldSettings settings = lensLattice();
-  const Vec3 a{0.0}, b{1.0, 0.0, 0.0}, rest{-0.5, 0.0, 0.8};
-  // The tethers' lengths: the rest distances, as RestReal.
-  const Real ra = static_cast<RestReal>(glm::length(rest - a)), rb = static_cast<RestReal>(glm::length(rest - b));
+  const Vec3 a{0.0}, b{1.0, 0.0, 0.0};
+  const Vec3 rest = World(settings).cloths()[0].rest.restPosition(4);  // (0.8 as a float offset)
+  // The tethers' lengths: the rest distances, rounded up to RestReal.
+  const Real ra = toRestLengthAtLeast(glm::length(rest - a)), rb = toRestLengthAtLeast(glm::length(rest - b));
   std::mt19937 random(11);
   std::uniform_real_distribution<Real> coordinate(-2.0, 2.0), unit(-1.0, 1.0);
   for (int trial = 0; trial < 100; ++trial) {
@@ -1009,8 +1011,9 @@ TEST(Tethers, WithAPinCarriedIntoTheOtherBallTheLensIsTheInnerBall) {
   std::mt19937 random(5);
   std::uniform_real_distribution<Real> coordinate(-3.0, 3.0);
   for (const Case& c : cases) {
-    const Real ra = static_cast<RestReal>(glm::length(c.rest - Vec3{0.0})),
-               rb = static_cast<RestReal>(glm::length(c.rest - Vec3{1.0, 0.0, 0.0}));
+    const Vec3 atRest = World(settings).cloths()[0].rest.restPosition(c.particle);  // c.rest, as kept
+    const Real ra = toRestLengthAtLeast(glm::length(atRest - Vec3{0.0})),
+               rb = toRestLengthAtLeast(glm::length(atRest - Vec3{1.0, 0.0, 0.0}));
     const bool aInner = ra < rb;
     const Vec3 inner = aInner ? c.a : c.b;
     const Real innerRadius = aInner ? ra : rb;

@@ -294,12 +294,26 @@ int bench(const BenchArguments& input) {
              format("%.2f ms", r->m.msPerFrame) + ", strain " + percent(r->m.strainMaxEnd),
              r->m.msPerFrame <= 8.0 && r->m.strainMaxEnd <= kStrainTarget && !r->m.diverged);
     }
+    // Judged on the first thread count (one, by default): each more thread keeps its own working
+    // rows for the line solves, as long as the longest line (so a share that shrinks as N grows),
+    // which the other counts' figures show.
+    const auto bytesPerParticle = [](const Row& r) {
+      return static_cast<double>(r.m.bytes) / static_cast<double>(r.m.particles);
+    };
     for (int n : arguments.sizes) {
-      const Row* r = find(n, "drape", arguments.threads.front());
+      const int threads = arguments.threads.front();
+      const Row* r = find(n, "drape", threads);
       if (!r) continue;
-      const double perParticle = static_cast<double>(r->m.bytes) / static_cast<double>(r->m.particles);
-      target("hang2 " + std::to_string(n) + ": <= 200 bytes per particle, constraints included",
-             format("%.0f bytes", perParticle), perParticle <= 200.0);
+      std::string measured = format("%.0f bytes", bytesPerParticle(*r));
+      for (std::size_t t = 1; t < arguments.threads.size(); ++t) {
+        if (const Row* other = find(n, "drape", arguments.threads[t])) {
+          measured += " (" + std::to_string(arguments.threads[t]) +
+                      " threads: " + format("%.0f", bytesPerParticle(*other)) + ")";
+        }
+      }
+      target("hang2 " + std::to_string(n) + ": <= 200 bytes per particle, constraints included, on " +
+                 (threads == 1 ? std::string("one thread") : std::to_string(threads) + " threads"),
+             measured, bytesPerParticle(*r) <= 200.0);
     }
     if (arguments.sizes.size() >= 2) {
       const Row* small = find(arguments.sizes.front(), "drape", 1);

@@ -55,6 +55,12 @@ void ClothRest::setRestPositions(const std::vector<Vec3>& positions) {
   restOffsets = std::move(offsets);
 }
 
+RestReal toRestLengthAtLeast(Real length) {
+  RestReal rest = toRestLength(length);
+  if (static_cast<Real>(rest) < length) rest = std::nextafter(rest, std::numeric_limits<RestReal>::max());
+  return rest;
+}
+
 namespace {
 
 void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {

@@ -219,8 +219,11 @@ void World::buildTethers(std::size_t c) {
     if (cloth.state.inverseMass[i] == 0.0) continue;
     for (const std::size_t p : pins) {
       if (cloth.pieceOf(i) != cloth.pieceOf(p)) continue;
-      // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth).
-      const RestReal length = toRestLength(glm::length(cloth.rest.restPosition(i) - cloth.rest.restPosition(p)));
+      // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth),
+      // rounded up, not to the nearest float: the rest shape must lie inside every tether, and
+      // where two pins' balls only just touch (the top row between them) a rounding down leaves
+      // no point in both.
+      const RestReal length = toRestLengthAtLeast(glm::length(cloth.rest.restPosition(i) - cloth.rest.restPosition(p)));
       tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
     }
   }

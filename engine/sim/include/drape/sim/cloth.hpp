@@ -33,6 +33,9 @@ struct DistanceConstraint {
 // A rest length as the engine keeps it (RestReal). Throws std::invalid_argument where `length` is
 // not a finite non-negative number that single precision holds, or is positive but rounds to 0.
 RestReal toRestLength(Real length);
+// ... rounded up instead of to the nearest: the least RestReal not below `length`. For a length
+// that must not come out shorter (a tether: the rest shape must lie within it).
+RestReal toRestLengthAtLeast(Real length);
 
 // Which world plane the lattice is laid out in at rest.
 enum class LatticePlane : std::uint8_t {
