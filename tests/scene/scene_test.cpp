@@ -405,12 +405,14 @@ TEST(Scene, SwitchingToTheForceModelTakesTheSubstepsItsSpringsNeed) {
 }
 
 TEST(Snapshot, AClothFarFromTheOriginComesBackOffsetForOffsetAndRunsOnBitForBit) {
-  // hang2-tear 7 km out: torn (tearing appends copies of particles), and untorn with tethers (they
+  // hang2-tear 7 km out: torn (tearing appends copies of particles), untorn with tethers (they
   // are measured between rest positions when the world is planned, so a change in the offsets would
-  // show in the steps after loading).
+  // show in the steps after loading), and torn with tethers (a torn-off copy is tied to its piece's
+  // pins as loading ties it).
   const std::string far = "cloths.0.origin=[-7123.456789,1.5,4987.654321]";
-  for (const std::vector<std::string>& overrides : {std::vector<std::string>{far, "tearing.threshold=1.03"},
-                                                    std::vector<std::string>{far, "solver.tethers=true"}}) {
+  for (const std::vector<std::string>& overrides :
+       {std::vector<std::string>{far, "tearing.threshold=1.03"}, std::vector<std::string>{far, "solver.tethers=true"},
+        std::vector<std::string>{far, "tearing.threshold=1.03", "solver.tethers=true"}}) {
     SCOPED_TRACE(overrides[1]);
     const Scene scene = loadScene(resolveScenePath("hang2-tear"), overrides);
     sim::World world(scene.world);
@@ -434,6 +436,39 @@ TEST(Snapshot, AClothFarFromTheOriginComesBackOffsetForOffsetAndRunsOnBitForBit)
     EXPECT_TRUE(loaded.cloths()[0].state.position == world.cloths()[0].state.position);
     EXPECT_EQ(loaded.cloths()[0].pieceCount, world.cloths()[0].pieceCount);
   }
+}
+
+TEST(Snapshot, ATetheredClothPinnedAndUnpinnedByHandRunsOnBitForBit) {
+  // The tethers go to the pins there are: a pin made with a finger, or taken out, ties them again,
+  // as loading a snapshot does. Else the world loaded from a snapshot runs on otherwise.
+  const Scene scene = loadScene(resolveScenePath("hang2-tear"),
+                                {"cloths.0.grid.columns=16", "cloths.0.grid.rows=16", "cloths.0.pins.1.particle=[15,0]",
+                                 "solver.tethers=true", "tearing.enabled=false"});
+  sim::World world(scene.world);
+  const sim::ClothRest& rest = world.cloths()[0].rest;
+  const auto at = [&](int column, int row) { return world.cloths()[0].state.position[rest.index(column, row)]; };
+  ASSERT_EQ(world.run(10), sim::StepStatus::ok);
+  const std::size_t tethers = world.tetherCount();
+  // Carry the far corner out and pin it there, then take out the first pin.
+  ASSERT_GT(world.pressFinger(1, at(15, 15), 0.01), 0);
+  world.moveFinger(1, at(15, 15) + sim::Vec3{0.3, 0.2, 0.0});
+  ASSERT_EQ(world.run(10), sim::StepStatus::ok);
+  ASSERT_GT(world.pinFinger(1), 0);
+  EXPECT_GT(world.tetherCount(), tethers);  // to the new pin too
+  ASSERT_EQ(world.run(10), sim::StepStatus::ok);
+  ASSERT_GT(world.unpin(at(0, 0), 0.01), 0);
+  ASSERT_EQ(world.run(5), sim::StepStatus::ok);
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("drape-pinned-" + std::to_string(::getpid()) + ".drape.json");
+  writeFileAtomically(file, snapshotDocument(scene, world).dump());
+  sim::World loaded = makeWorld(loadSnapshot(file));
+  std::filesystem::remove(file);
+  EXPECT_EQ(loaded.tetherCount(), world.tetherCount());
+  for (int step = 0; step < 20; ++step) {
+    ASSERT_EQ(world.step(), sim::StepStatus::ok);
+    ASSERT_EQ(loaded.step(), sim::StepStatus::ok);
+  }
+  EXPECT_TRUE(loaded.cloths()[0].state.position == world.cloths()[0].state.position);
 }
 
 TEST(Snapshot, ARestPositionSinglePrecisionCannotHoldIsRefusedByName) {

@@ -1102,9 +1102,11 @@ TEST(Tethers, NoneReachesAcrossACut) {
   EXPECT_EQ(world.tetherCount(), 2 * freeParticles);
   ASSERT_EQ(world.cut(Vec3{0.001, 1.5, -0.7}, Vec3{0.001, 1.5, 0.7}, Vec3{0.0, -1.0, 0.0}), 1);
   ASSERT_EQ(cloth.pieceCount, 2u);
-  EXPECT_EQ(world.tetherCount(), freeParticles);  // each particle keeps the pin of its own half
-  // (The cut splits the particles of column n / 2: each original stays with the left half, and its
-  // copy, which has no tethers, goes with the right.)
+  // Each particle is tied to the pin of its own half only. (The cut splits the particles of column
+  // n / 2: each original stays with the left half, and its copy, tied as a particle of the right
+  // half, goes with it.)
+  ASSERT_EQ(cloth.state.position.size(), static_cast<std::size_t>(n * n + n));
+  EXPECT_EQ(world.tetherCount(), cloth.state.position.size() - 2);
   const ParticleIndex leftPin = cloth.rest.index(0, 0), nextToCut = cloth.rest.index(n / 2 + 1, 0);
   ASSERT_NE(cloth.pieceOf(nextToCut), cloth.pieceOf(leftPin));
   const Real rest = glm::distance(cloth.rest.restPosition(nextToCut), cloth.rest.restPosition(leftPin));

@@ -214,9 +214,10 @@ void World::buildTethers(std::size_t c) {
     if (cloth.state.pinned[p]) pins.push_back(p);
   }
   // Particle by particle, so that a particle's tethers are consecutive and projected together.
+  // Every particle not pinned has them, a held one too (the tethers skip it while it is held).
   std::vector<SolverScratch::Tethers::Tether> tethers;
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-    if (cloth.state.inverseMass[i] == 0.0) continue;
+    if (cloth.state.pinned[i]) continue;
     for (const std::size_t p : pins) {
       if (cloth.pieceOf(i) != cloth.pieceOf(p)) continue;
       // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth),
@@ -748,9 +749,16 @@ bool World::releaseFinger(int id) {
 int World::pinFinger(int id) {
   Finger* f = findFinger(id);
   if (!f) return -1;
-  for (const FingerGrip& grip : f->grips) cloths_[static_cast<std::size_t>(grip.cloth)].state.pinned[grip.particle] = 1;
+  std::vector<std::size_t> changed;
+  for (const FingerGrip& grip : f->grips) {
+    const auto c = static_cast<std::size_t>(grip.cloth);
+    cloths_[c].state.pinned[grip.particle] = 1;
+    if (std::find(changed.begin(), changed.end(), c) == changed.end()) changed.push_back(c);
+  }
   const int pinned = static_cast<int>(f->grips.size());
   releaseFinger(id);
+  for (const std::size_t c : changed) buildTethers(c);  // to the new pins too
+  buildPipeline();
   return pinned;
 }
 
@@ -759,14 +767,18 @@ int World::unpin(Vec3 point, Real radius) {
   int freed = 0;
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     ParticleState& s = cloths_[c].state;
+    bool changed = false;
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       const Vec3 d = s.position[i] - point;
       if (!s.pinned[i] || isHeld(c, i) || glm::dot(d, d) > radius * radius) continue;
       s.pinned[i] = 0;
       s.inverseMass[i] = 1.0 / s.mass[i];
       ++freed;
+      changed = true;
     }
+    if (changed) buildTethers(c);  // none to what is no longer a pin, and the freed particle's own
   }
+  if (freed > 0) buildPipeline();
   return freed;
 }
 
@@ -819,10 +831,9 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   grow(scratch.sumPosition, n);
   grow(scratch.sumVelocity, n);
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
-  // A tether may not reach across a tear.
-  std::vector<SolverScratch::Tethers::Tether> tethers = scratch.tethers.list();
-  std::erase_if(tethers, [&](const auto& t) { return cloth.pieceOf(t.particle) != cloth.pieceOf(t.pin); });
-  scratch.tethers.assign(tethers);
+  // A tether may not reach across a tear; a torn-off copy of a particle is tied to its piece's pins
+  // as the particle was. (Built afresh, as loading a snapshot builds them.)
+  buildTethers(c);
   topologyVersion_ = nextTopologyVersion();
 }
 
