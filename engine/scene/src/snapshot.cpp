@@ -1,5 +1,6 @@
 #include "drape/scene/snapshot.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -74,6 +75,7 @@ json snapshotDocument(const Scene& scene, const sim::World& world) {
       if (cloth.state.pinned[i]) pinned.push_back(i);
     }
     c["pinned"] = std::move(pinned);
+    c["tetherPins"] = cloth.tetherPins;
     c["lattice"] = {cloth.rest.columns, cloth.rest.rows};
     cloths.push_back(std::move(c));
   }
@@ -152,6 +154,17 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
                                    });
     s.pinned.assign(n, 0);
     for (std::uint32_t p : tuples<std::uint32_t>(reader, "pinned", 1, particle, index)) s.pinned[p] = 1;
+    // The pins the tethers go to (the cloth's own, not those pinned by hand); a snapshot without
+    // them ties every pin.
+    if (reader.has("tetherPins")) {
+      cloth.tetherPins = tuples<std::uint32_t>(reader, "tetherPins", 1, particle, index);
+      std::sort(cloth.tetherPins.begin(), cloth.tetherPins.end());
+      cloth.tetherPins.erase(std::unique(cloth.tetherPins.begin(), cloth.tetherPins.end()), cloth.tetherPins.end());
+    } else {
+      for (std::uint32_t p = 0; p < n; ++p) {
+        if (s.pinned[p]) cloth.tetherPins.push_back(p);
+      }
+    }
     s.inverseMass.assign(n, 0.0);
     const json* lattice = reader.raw("lattice");
     if (lattice && lattice->is_array() && lattice->size() == 2 && (*lattice)[0].is_number_integer() &&

@@ -167,7 +167,11 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
     s.inverseMass[p] = 0.0;
     s.pinned[p] = 1;
     if (pin.position) s.position[p] = *pin.position;
+    if (std::find(cloth.tetherPins.begin(), cloth.tetherPins.end(), p) == cloth.tetherPins.end()) {
+      cloth.tetherPins.push_back(p);
+    }
   }
+  std::sort(cloth.tetherPins.begin(), cloth.tetherPins.end());
   s.previousPosition = s.position;
   if (model == Model::force) {
     s.velocity.assign(n, settings.initialVelocity);
@@ -210,7 +214,7 @@ void World::buildTethers(std::size_t c) {
   if (!settings_.solver.tethers || settings_.solver.model != Model::position) return;
   const Cloth& cloth = cloths_[c];
   std::vector<std::size_t> pins;
-  for (std::size_t p = 0; p < cloth.state.position.size(); ++p) {
+  for (const ParticleIndex p : cloth.tetherPins) {
     if (cloth.state.pinned[p]) pins.push_back(p);
   }
   // Particle by particle, so that a particle's tethers are consecutive and projected together.
@@ -757,7 +761,8 @@ int World::pinFinger(int id) {
   }
   const int pinned = static_cast<int>(f->grips.size());
   releaseFinger(id);
-  for (const std::size_t c : changed) buildTethers(c);  // to the new pins too
+  // A pinned particle has no tethers of its own; none go to these pins (Cloth::tetherPins).
+  for (const std::size_t c : changed) buildTethers(c);
   buildPipeline();
   return pinned;
 }
@@ -774,9 +779,12 @@ int World::unpin(Vec3 point, Real radius) {
       s.pinned[i] = 0;
       s.inverseMass[i] = 1.0 / s.mass[i];
       ++freed;
+      std::vector<ParticleIndex>& anchors = cloths_[c].tetherPins;
+      const auto anchor = std::find(anchors.begin(), anchors.end(), static_cast<ParticleIndex>(i));
+      if (anchor != anchors.end()) anchors.erase(anchor);  // for good: pinned again by hand it is anywhere
       changed = true;
     }
-    if (changed) buildTethers(c);  // none to what is no longer a pin, and the freed particle's own
+    if (changed) buildTethers(c);  // none to what is no longer a pin; the freed particle's own
   }
   if (freed > 0) buildPipeline();
   return freed;
@@ -952,6 +960,8 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
               "a cloth has a position that is not finite");
       require(std::isfinite(s.mass[i]) && s.mass[i] > 0.0f, "a particle's mass must be positive");
     }
+    for (const ParticleIndex p : cloth.tetherPins)
+      require(p < n, "a tether pin names a particle the cloth does not have");
     for (const glm::uvec3& t : cloth.rest.triangles) {
       require(t.x < n && t.y < n && t.z < n, "a triangle names a particle the cloth does not have");
       require(t.x != t.y && t.y != t.z && t.z != t.x, "a triangle names one particle twice");

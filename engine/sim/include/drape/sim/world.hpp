@@ -29,6 +29,10 @@ struct Cloth {
   std::vector<std::uint32_t> piece;
   std::uint32_t pieceCount = 1;
   std::uint32_t pieceOf(std::size_t particle) const { return piece.empty() ? 0 : piece[particle]; }
+  // The pins the tethers (solver.tethers) go to: the cloth's own, as it was built (ClothSettings::
+  // pins), less those taken out since. A particle pinned by hand gets none: it may have been put
+  // anywhere, where its rest distances cannot all hold.
+  std::vector<ParticleIndex> tetherPins;
 };
 
 // A finger holding particles (the seed's sticky finger). Each held particle keeps its offset from
