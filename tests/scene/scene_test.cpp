@@ -407,12 +407,14 @@ TEST(Scene, SwitchingToTheForceModelTakesTheSubstepsItsSpringsNeed) {
 TEST(Snapshot, AClothFarFromTheOriginComesBackOffsetForOffsetAndRunsOnBitForBit) {
   // hang2-tear 7 km out: torn (tearing appends copies of particles), untorn with tethers (they
   // are measured between rest positions when the world is planned, so a change in the offsets would
-  // show in the steps after loading), and torn with tethers (a torn-off copy is tied to its piece's
-  // pins as loading ties it).
+  // show in the steps after loading), torn with tethers (a torn-off copy is tied to its piece's
+  // pins as loading ties it), and torn with lines (which put the stretch constraints in line order,
+  // and must find the same lines in the loaded order).
   const std::string far = "cloths.0.origin=[-7123.456789,1.5,4987.654321]";
   for (const std::vector<std::string>& overrides :
        {std::vector<std::string>{far, "tearing.threshold=1.03"}, std::vector<std::string>{far, "solver.tethers=true"},
-        std::vector<std::string>{far, "tearing.threshold=1.03", "solver.tethers=true"}}) {
+        std::vector<std::string>{far, "tearing.threshold=1.03", "solver.tethers=true"},
+        std::vector<std::string>{far, "tearing.threshold=1.03", "solver.lines=true"}}) {
     SCOPED_TRACE(overrides[1]);
     const Scene scene = loadScene(resolveScenePath("hang2-tear"), overrides);
     sim::World world(scene.world);

@@ -58,8 +58,8 @@ TEST(Lattice, RestLengthsSinglePrecisionCannotHoldAreRefused) {
 TEST(Lattice, MassesSinglePrecisionCannotHoldAreRefused) {
   EXPECT_EQ(toMass(0.25), 0.25f);
   EXPECT_EQ(toMass(0.1), 0.1f);  // rounded as a float rounds
-  for (const Real bad : {0.0, -1.0, 1e39, 1e-50, std::numeric_limits<Real>::infinity(), std::nan("")}) {
-    EXPECT_THROW(toMass(bad), std::invalid_argument) << bad;
+  for (const Real bad : {0.0, -1.0, 1e39, 1e-40, 1e-50, std::numeric_limits<Real>::infinity(), std::nan("")}) {
+    EXPECT_THROW(toMass(bad), std::invalid_argument) << bad;  // (1e-40: subnormal)
   }
   // A world whose particles would weigh that is refused, not built with masses of 0.
   WorldSettings settings;

@@ -172,7 +172,6 @@ void sever(Topology& topology, std::uint32_t t, int edge) {
   }
 }
 
-// Gives every fan of triangles around each touched particle but the first a particle of its own.
 // About `wanted` kilograms taken from `left` (wanted > 0): the share, with what is left in `left`,
 // the two adding up to what `left` was exactly. Where the share is at least half of left, left -
 // share is exact (Sterbenz); else left - share rounded is at least half of left, and left minus
@@ -190,6 +189,7 @@ MassReal takeShare(MassReal& left, Real wanted) {
   return share;
 }
 
+// Gives every fan of triangles around each touched particle but the first a particle of its own.
 void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_t budget,
                     std::vector<ParticleSplit>& splits) {
   ClothRest& rest = cloth.rest;

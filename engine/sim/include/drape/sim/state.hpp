@@ -21,7 +21,7 @@ struct ParticleState {
 };
 
 // A mass as the engine keeps it (MassReal). Throws std::invalid_argument where `mass` is not a
-// positive finite number that single precision holds (at most 3.4e38 kg, not rounding to 0).
+// positive finite number that single precision holds as a normal number (1.2e-38 to 3.4e38 kg).
 MassReal toMass(Real mass);
 
 }  // namespace drape::sim

@@ -148,7 +148,8 @@ class World {
   // Lets go: the particles fly on with the finger's last velocity (a flick throws the cloth).
   bool releaseFinger(int id);
   // Lifts the finger but leaves what it held pinned where it is. Returns how many particles were
-  // pinned, or -1 if the id is not down.
+  // pinned, or -1 if the id is not down. No tethers go to these pins (Cloth::tetherPins); the
+  // pinned particles lose their own.
   int pinFinger(int id);
   // Frees the pinned particles within `radius` of `point` (not those a finger holds). Returns how many.
   int unpin(Vec3 point, Real radius);
@@ -185,7 +186,10 @@ class World {
  private:
   void buildPipeline();
   void buildTethers(std::size_t cloth);
-  void plan(std::size_t cloth);  // batches and lines for the cloth's current constraints
+  // Batches and lines for the cloth's current constraints, once per topology (and after setThreads
+  // or tune): it reorders the cloth's constraints (bend and shear into batches, stretch into line
+  // order, lines::build), so their order in cloths() changes at the first step and after a tear.
+  void plan(std::size_t cloth);
   void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits);
   void moveFingers(Real h);
   void tear();
