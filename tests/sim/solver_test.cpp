@@ -380,6 +380,26 @@ TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
       EXPECT_EQ(again.constraints[kind][k].b, rest.constraints[kind][k].b);
     }
   }
+  // Without the stretch constraints (with lines, which order them): those stay as they came, with
+  // no batches, and the other kinds are coloured as before.
+  const std::size_t stretch = static_cast<std::size_t>(ConstraintKind::stretch);
+  const auto sameOrder = [](const std::vector<DistanceConstraint>& x, const std::vector<DistanceConstraint>& y) {
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      if (x[k].a != y[k].a || x[k].b != y[k].b) return false;
+    }
+    return x.size() == y.size();
+  };
+  ASSERT_FALSE(sameOrder(rest.constraints[stretch], before.constraints[stretch]));  // colouring moves them
+  ClothRest lined = before;
+  const batches::Batches others = batches::colour(lined, nullptr, false);
+  EXPECT_TRUE(sameOrder(lined.constraints[stretch], before.constraints[stretch]));
+  EXPECT_TRUE(others.start[stretch].empty());
+  EXPECT_FALSE(others.sequentialTail[stretch]);
+  for (const ConstraintKind kind : {ConstraintKind::shear, ConstraintKind::bend}) {
+    EXPECT_EQ(others.start[static_cast<std::size_t>(kind)], made.start[static_cast<std::size_t>(kind)]);
+    EXPECT_TRUE(
+        sameOrder(lined.constraints[static_cast<std::size_t>(kind)], rest.constraints[static_cast<std::size_t>(kind)]));
+  }
 }
 
 TEST(Batches, FourAtATimeTheProjectionsGiveTheSameBitsAsOneByOne) {

@@ -1,6 +1,5 @@
 #include "drape/scene/snapshot.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -144,7 +143,7 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
     s.position = tuples<sim::Vec3>(reader, "positions", 3, "[x, y, z], finite", vec3);
     s.previousPosition = tuples<sim::Vec3>(reader, "previousPositions", 3, "[x, y, z], finite", vec3);
     if (reader.has("velocities")) s.velocity = tuples<sim::Vec3>(reader, "velocities", 3, "[x, y, z], finite", vec3);
-    s.mass = tuples<sim::MassReal>(reader, "masses", 1, "a positive mass in kg, at most 3.4e38",
+    s.mass = tuples<sim::MassReal>(reader, "masses", 1, "a mass in kg, 1.2e-38 to 3.4e38",
                                    [](const json& m) -> std::optional<sim::MassReal> {
                                      try {
                                        return sim::toMass(m.get<double>());
@@ -158,8 +157,6 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
     // them ties every pin.
     if (reader.has("tetherPins")) {
       cloth.tetherPins = tuples<std::uint32_t>(reader, "tetherPins", 1, particle, index);
-      std::sort(cloth.tetherPins.begin(), cloth.tetherPins.end());
-      cloth.tetherPins.erase(std::unique(cloth.tetherPins.begin(), cloth.tetherPins.end()), cloth.tetherPins.end());
     } else {
       for (std::uint32_t p = 0; p < n; ++p) {
         if (s.pinned[p]) cloth.tetherPins.push_back(p);

@@ -5,13 +5,14 @@
 
 namespace drape::sim::batches {
 
-Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source) {
+Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source, bool stretchToo) {
   Batches result;
   const std::size_t n = rest.particleCount();
   std::vector<std::uint64_t> used(n);
   std::vector<std::uint8_t> colourOf;
   std::vector<DistanceConstraint> sorted;
   for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
+    if (!stretchToo && kind == static_cast<std::size_t>(ConstraintKind::stretch)) continue;
     std::vector<DistanceConstraint>& constraints = rest.constraints[kind];
     std::fill(used.begin(), used.end(), 0);
     colourOf.resize(constraints.size());

@@ -27,6 +27,9 @@ struct Batches {
 // Reorders rest.constraints in place (stable within a batch) and returns the batches. Applying it
 // to constraints it has already ordered changes nothing. `source`, if given (a torn cloth's
 // Topology::source: per constraint, the recipe it came from), is reordered along with them.
-Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source = nullptr);
+// Without `stretchToo` the stretch constraints are left as they are, with no batches (the lines
+// order and solve them).
+Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source = nullptr,
+               bool stretchToo = true);
 
 }  // namespace drape::sim::batches

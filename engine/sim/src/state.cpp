@@ -14,8 +14,7 @@ MassReal toMass(Real mass) {
   if (mass < static_cast<Real>(std::numeric_limits<MassReal>::min())) {
     throw std::invalid_argument("a particle's mass must be at least 1.2e-38 kg");
   }
-  const auto kept = static_cast<MassReal>(mass);
-  return kept;
+  return static_cast<MassReal>(mass);
 }
 
 std::vector<SolverScratch::Tethers::Tether> SolverScratch::Tethers::list() const {

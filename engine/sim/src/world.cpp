@@ -133,6 +133,11 @@ Stage integratorStage(Integrator integrator) {
   return Stage::rk4;
 }
 
+void sortUnique(std::vector<ParticleIndex>& list) {
+  std::sort(list.begin(), list.end());
+  list.erase(std::unique(list.begin(), list.end()), list.end());
+}
+
 Cloth makeCloth(const ClothSettings& settings, Model model) {
   Cloth cloth;
   cloth.settings = settings;
@@ -167,11 +172,9 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
     s.inverseMass[p] = 0.0;
     s.pinned[p] = 1;
     if (pin.position) s.position[p] = *pin.position;
-    if (std::find(cloth.tetherPins.begin(), cloth.tetherPins.end(), p) == cloth.tetherPins.end()) {
-      cloth.tetherPins.push_back(p);
-    }
+    cloth.tetherPins.push_back(p);
   }
-  std::sort(cloth.tetherPins.begin(), cloth.tetherPins.end());
+  sortUnique(cloth.tetherPins);
   s.previousPosition = s.position;
   if (model == Model::force) {
     s.velocity.assign(n, settings.initialVelocity);
@@ -326,14 +329,13 @@ void World::plan(std::size_t c) {
     // The fast sweep's batches: the constraints are put in batch order, once per topology.
     Cloth& cloth = cloths_[c];
     // A torn cloth's constraints each name their recipe: the names move with them.
-    const batches::Batches made = batches::colour(cloth.rest, cloth.topology.built ? &cloth.topology.source : nullptr);
+    // The stretch constraints have none: the lines put them in line order and solve them (a loose
+    // one one by one).
+    const batches::Batches made =
+        batches::colour(cloth.rest, cloth.topology.built ? &cloth.topology.source : nullptr, false);
     scratch.batchStart = made.start;
     scratch.sequentialTail = made.sequentialTail;
-    // ... except the stretch constraints, which the lines put in line order and solve (a loose one
-    // one by one): they have no batches.
     lines::build(cloth, scratch, workers_->threads());
-    scratch.batchStart[static_cast<std::size_t>(ConstraintKind::stretch)].clear();
-    scratch.sequentialTail[static_cast<std::size_t>(ConstraintKind::stretch)] = false;
   } else {
     scratch.batchStart = {};
     scratch.lines = {};
@@ -958,7 +960,9 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
       require(finite(cloth.rest.restPosition(i)) && finite(s.position[i]) && finite(s.previousPosition[i]) &&
                   (s.velocity.empty() || finite(s.velocity[i])),
               "a cloth has a position that is not finite");
-      require(std::isfinite(s.mass[i]) && s.mass[i] > 0.0f, "a particle's mass must be positive");
+      // As toMass would keep it: a normal float (a tear halves masses).
+      require(std::isfinite(s.mass[i]) && s.mass[i] >= std::numeric_limits<MassReal>::min(),
+              "a particle's mass must be positive, at least 1.2e-38 kg");
     }
     for (const ParticleIndex p : cloth.tetherPins)
       require(p < n, "a tether pin names a particle the cloth does not have");
@@ -993,6 +997,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
       if (!s.velocity.empty()) s.velocity[i] = Vec3{0.0};
     }
     cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
+    sortUnique(cloth.tetherPins);  // as makeCloth keeps them
     held_.emplace_back();
     buildTethers(c);
     if (settings_.solver.model == Model::force)
