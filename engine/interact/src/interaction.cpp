@@ -117,6 +117,10 @@ std::optional<Vec3> Interaction::pointOnPlane(const Pointer& pointer, Vec3 ancho
 
 bool Interaction::down(int id, const Pointer& pointer, std::optional<Real> radius) {
   if (find(id)) return fail("finger " + std::to_string(id) + " is already down");
+  if (touches_.size() >= static_cast<std::size_t>(sim::kMaxFingers)) {
+    return fail("finger " + std::to_string(id) + ": " + std::to_string(sim::kMaxFingers) +
+                " fingers are down already, the most there can be");
+  }
   const Real r = radius.value_or(settings_.radius);
   if (!(r > 0.0) || !std::isfinite(r)) return fail("finger radius must be a positive number");
   Touch touch;

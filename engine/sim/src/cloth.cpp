@@ -65,8 +65,16 @@ namespace {
 
 void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
   const RestReal restLength = toRestLength(glm::length(rest.restPosition(b) - rest.restPosition(a)));
-  // Lattice points are apart: they coincide only where single precision could not hold the spacing.
-  if (restLength == 0.0f) throw std::invalid_argument("lattice spacing is too fine for single precision");
+  // Lattice points are apart: they coincide only where the precision of the positions could not hold
+  // the spacing. The message names the lattice's key the spacing comes from, as the reader spells it.
+  if (restLength == 0.0f) {
+    const bool sameRow = a / rest.columns == b / rest.columns, sameColumn = a % rest.columns == b % rest.columns;
+    throw std::invalid_argument(std::string("grid.") +
+                                (sameRow      ? "width"
+                                 : sameColumn ? "height"
+                                              : "width") +
+                                ": the lattice spacing is too fine for the precision of its positions");
+  }
   rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
 }
 

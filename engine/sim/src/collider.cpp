@@ -151,27 +151,48 @@ void Collider::buildGrid() {
   const Vec3 size = upper - lower;
   cellSize_ = std::max({2.0 * edges / (3.0 * static_cast<Real>(mesh.triangles.size())),
                         std::max({size.x, size.y, size.z}) / 128.0, 1e-6});
-  gridOrigin_ = lower - cellSize_ * 0.5;
-  gridCells_ = glm::ivec3(glm::floor((size + cellSize_) / cellSize_)) + 1;
-  const std::size_t cellCount = static_cast<std::size_t>(gridCells_.x) * gridCells_.y * gridCells_.z;
-  std::vector<std::vector<std::uint32_t>> cells(cellCount);
-  for (std::uint32_t i = 0; i < mesh.triangles.size(); ++i) {
-    const glm::uvec3& t = mesh.triangles[i];
+  // A triangle is listed in every cell its bounding box touches. A few large triangles among many
+  // small ones (small cells) would be listed millions of times each, so the cells grow until
+  // the lists hold at most this many entries in all.
+  const std::uint64_t budget = 16 * static_cast<std::uint64_t>(mesh.triangles.size()) + (std::uint64_t{1} << 22);
+  const auto cellRange = [&](const glm::uvec3& t) {
     const Vec3 a = mesh.vertices[t.x], b = mesh.vertices[t.y], c = mesh.vertices[t.z];
-    const glm::ivec3 from = glm::ivec3(glm::floor((glm::min(a, glm::min(b, c)) - gridOrigin_) / cellSize_));
-    const glm::ivec3 to = glm::ivec3(glm::floor((glm::max(a, glm::max(b, c)) - gridOrigin_) / cellSize_));
+    return std::pair{glm::ivec3(glm::floor((glm::min(a, glm::min(b, c)) - gridOrigin_) / cellSize_)),
+                     glm::ivec3(glm::floor((glm::max(a, glm::max(b, c)) - gridOrigin_) / cellSize_))};
+  };
+  std::uint64_t entries = 0;
+  while (true) {
+    gridOrigin_ = lower - cellSize_ * 0.5;
+    gridCells_ = glm::ivec3(glm::floor((size + cellSize_) / cellSize_)) + 1;
+    entries = 0;
+    for (const glm::uvec3& t : mesh.triangles) {
+      const auto [from, to] = cellRange(t);
+      const glm::ivec3 span = to - from + 1;
+      entries +=
+          static_cast<std::uint64_t>(span.x) * static_cast<std::uint64_t>(span.y) * static_cast<std::uint64_t>(span.z);
+      if (entries > budget) break;
+    }
+    if (entries <= budget) break;
+    cellSize_ *= 2.0;
+  }
+  const std::size_t cellCount = static_cast<std::size_t>(gridCells_.x) * gridCells_.y * gridCells_.z;
+  const auto forEachCell = [&](const glm::uvec3& t, auto&& visit) {
+    const auto [from, to] = cellRange(t);
     for (int z = from.z; z <= to.z; ++z) {
       for (int y = from.y; y <= to.y; ++y) {
-        for (int x = from.x; x <= to.x; ++x)
-          cells[static_cast<std::size_t>((z * gridCells_.y + y) * gridCells_.x + x)].push_back(i);
+        for (int x = from.x; x <= to.x; ++x) visit(static_cast<std::size_t>((z * gridCells_.y + y) * gridCells_.x + x));
       }
     }
-  }
+  };
+  // Counted first, then filled: two flat arrays, not a list per cell.
   cellStart_.assign(cellCount + 1, 0);
-  for (std::size_t i = 0; i < cellCount; ++i)
-    cellStart_[i + 1] = cellStart_[i] + static_cast<std::uint32_t>(cells[i].size());
-  cellTriangles_.reserve(cellStart_.back());
-  for (const auto& cell : cells) cellTriangles_.insert(cellTriangles_.end(), cell.begin(), cell.end());
+  for (const glm::uvec3& t : mesh.triangles) forEachCell(t, [&](std::size_t cell) { ++cellStart_[cell + 1]; });
+  for (std::size_t i = 0; i < cellCount; ++i) cellStart_[i + 1] += cellStart_[i];
+  cellTriangles_.assign(entries, 0);
+  std::vector<std::uint32_t> filled(cellStart_.begin(), cellStart_.end() - 1);
+  for (std::uint32_t i = 0; i < mesh.triangles.size(); ++i) {
+    forEachCell(mesh.triangles[i], [&](std::size_t cell) { cellTriangles_[filled[cell]++] = i; });
+  }
 }
 
 }  // namespace drape::sim

@@ -16,6 +16,7 @@
 #include "force_model.hpp"
 #include "lines.hpp"
 #include "position_model.hpp"
+#include "tethers.hpp"
 #include "topology.hpp"
 #include "workers.hpp"
 
@@ -202,8 +203,14 @@ std::uint64_t nextTopologyVersion() {
 World::World(WorldSettings settings)
     : settings_(std::move(settings)), topologyVersion_(nextTopologyVersion()), workers_(std::make_unique<Workers>(1)) {
   validate(settings_);
-  for (const ClothSettings& clothSettings : settings_.cloths) {
-    cloths_.push_back(makeCloth(clothSettings, settings_.solver.model));
+  for (std::size_t c = 0; c < settings_.cloths.size(); ++c) {
+    try {
+      cloths_.push_back(makeCloth(settings_.cloths[c], settings_.solver.model));
+    } catch (const std::invalid_argument& error) {
+      // "cloths.2: ...", or "cloths.2.grid.width: ..." where the message names a key of the cloth.
+      const std::string what = error.what();
+      throw std::invalid_argument("cloths." + std::to_string(c) + (what.starts_with("grid.") ? "." : ": ") + what);
+    }
   }
   require(particleCount() <= static_cast<std::size_t>(kMaxParticles), "too many particles");
   scratch_.resize(cloths_.size());
@@ -215,26 +222,7 @@ World::World(WorldSettings settings)
 
 void World::buildTethers(std::size_t c) {
   if (!settings_.solver.tethers || settings_.solver.model != Model::position) return;
-  const Cloth& cloth = cloths_[c];
-  std::vector<std::size_t> pins;
-  for (const ParticleIndex p : cloth.tetherPins) {
-    if (cloth.state.pinned[p]) pins.push_back(p);
-  }
-  // Particle by particle, so that a particle's tethers are consecutive and projected together.
-  // Every particle not pinned has them, a held one too (the tethers skip it while it is held).
-  std::vector<SolverScratch::Tethers::Tether> tethers;
-  for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
-    if (cloth.state.pinned[i]) continue;
-    for (const std::size_t p : pins) {
-      if (cloth.pieceOf(i) != cloth.pieceOf(p)) continue;
-      // As far from the pin as it is at rest (Euclidean: never shorter than the path in the cloth),
-      // rounded up, not to the nearest float: the rest shape must lie inside every tether, and
-      // where two pins' balls only just touch (the top row between them) a rounding down leaves
-      // no point in both.
-      const RestReal length = toRestLengthAtLeast(glm::length(cloth.rest.restPosition(i) - cloth.rest.restPosition(p)));
-      tethers.push_back({static_cast<ParticleIndex>(i), static_cast<ParticleIndex>(p), length});
-    }
-  }
+  const std::vector<SolverScratch::Tethers::Tether> tethers = nearestPinTethers(cloths_[c]);
   scratch_[c].tethers.assign(tethers);
 }
 
@@ -678,7 +666,10 @@ void World::grab(Finger& finger, std::size_t c, ParticleIndex nearest) {
 }
 
 int World::pressFinger(int id, Vec3 point, Real radius) {
-  if (finger(id) || !finite(point) || !finite(radius) || !(radius > 0.0)) return -1;
+  if (finger(id) || fingers_.size() >= static_cast<std::size_t>(kMaxFingers) || !finite(point) || !finite(radius) ||
+      !(radius > 0.0)) {
+    return -1;
+  }
   Finger f;
   f.id = id;
   f.position = f.target = point;
@@ -703,8 +694,8 @@ int World::pressFinger(int id, Vec3 point, Real radius) {
 }
 
 std::optional<Vec3> World::pressFingerAlongRay(int id, Vec3 origin, Vec3 direction, Real radius) {
-  if (finger(id) || !finite(origin) || !finite(direction) || !(glm::length(direction) > 0.0) || !finite(radius) ||
-      !(radius > 0.0)) {
+  if (finger(id) || fingers_.size() >= static_cast<std::size_t>(kMaxFingers) || !finite(origin) || !finite(direction) ||
+      !(glm::length(direction) > 0.0) || !finite(radius) || !(radius > 0.0)) {
     return std::nullopt;
   }
   const Vec3 unit = glm::normalize(direction);

@@ -73,6 +73,8 @@ class Collider {
   SurfaceDistance distance(Vec3 p, Real reach) const;
   // Velocity of the collider's material at world point p (for friction against moving surfaces).
   Vec3 surfaceVelocity(Vec3 p) const;
+  // Bytes it keeps beside its settings: a mesh's grid, bounded by the mesh's triangle count.
+  std::size_t gridBytes() const { return (cellStart_.capacity() + cellTriangles_.capacity()) * sizeof(std::uint32_t); }
 
  private:
   SurfaceDistance local(Vec3 p, Real reach) const;

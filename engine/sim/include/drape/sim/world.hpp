@@ -75,6 +75,9 @@ struct MemoryUse {
 };
 
 inline constexpr int kMaxThreads = 64;
+// Fingers down at once: more hands than a table has room for, few enough that what compares every
+// finger with every other (pinch-lift) stays cheap.
+inline constexpr int kMaxFingers = 256;
 
 // How many lines the full Newton line step (solver.geometricStiffness) solves side by side on this
 // CPU: 8 where it has AVX (chosen at run time, in the portable build too), else 4. The results are
@@ -132,11 +135,11 @@ class World {
   // quite stable undamped). Infinity in the position model or without springs.
   Real stableForceSubstep() const;
 
-  // Fingers. Any number may be down at once, each under the caller's id.
+  // Fingers. Up to kMaxFingers may be down at once, each under the caller's id.
   // press: every particle within `radius` of `point` on the piece of the particle nearest to it
   // sticks to the finger, except particles another finger already holds (the first finger keeps
   // them). Returns how many it holds (a finger that touches nothing is still down), or -1 if the id
-  // is already down or the numbers are not finite and positive.
+  // is already down, kMaxFingers are down, or the numbers are not finite and positive.
   int pressFinger(int id, Vec3 point, Real radius);
   // As press, at the point of the ray (origin + t direction, t > 0) nearest to the first particle
   // the ray passes within `radius` of. Returns that point, or nothing if the ray meets no cloth (the
