@@ -12,66 +12,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_fixture.hpp"
+
 namespace {
 
-namespace fs = std::filesystem;
+using namespace drape::test;
 using nlohmann::json;
-
-struct Result {
-  int exitCode;
-  std::string out;
-  std::string err;
-};
-
-class Cli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    directory_ =
-        fs::temp_directory_path() / ("drape-cli-test-" + std::string(test->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(directory_);
-    fs::create_directories(directory_);
-  }
-  void TearDown() override { fs::remove_all(directory_); }
-
-  fs::path file(const std::string& name) const { return directory_ / name; }
-
-  fs::path write(const std::string& name, const std::string& contents) const {
-    std::ofstream(file(name)) << contents;
-    return file(name);
-  }
-
-  static std::string read(const fs::path& path) {
-    std::ifstream in(path);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
-
-  // Runs drape-cli with `arguments` (shell words), capturing stdout and stderr.
-  Result run(const std::string& arguments) const {
-    const fs::path out = file("stdout.txt"), err = file("stderr.txt");
-    const std::string command =
-        std::string("'") + DRAPE_CLI + "' " + arguments + " >'" + out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read(out), read(err)};
-  }
-
-  // A minimal valid scene with one 4 x 3 cloth.
-  static json scene() {
-    return json::parse(R"({"solver": {"dt": 0.01}, "cloths": [{"grid": {"columns": 4, "rows": 3, "width": 0.3,
-      "height": 0.2}, "origin": [0, 1, 0], "pins": [{"particle": [0, 0]}]}]})");
-  }
-
-  fs::path directory_;
-};
-
-void expectOneLineError(const Result& result, int exitCode, const std::string& fragment) {
-  EXPECT_EQ(result.exitCode, exitCode) << result.err;
-  EXPECT_NE(result.err.find(fragment), std::string::npos) << "stderr: " << result.err;
-  EXPECT_EQ(result.err.rfind("drape-cli: error: ", 0), 0u) << result.err;
-  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
-}
 
 TEST_F(Cli, ValidatesTheShippedScenes) {
   for (const char* name :

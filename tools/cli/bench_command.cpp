@@ -86,16 +86,16 @@ std::string plotData(const std::vector<Row>& rows, const std::vector<int>& threa
   return data.str();
 }
 
-std::string plotScript(const std::filesystem::path& directory, const std::vector<int>& threads,
-                       const std::vector<int>& sweeps) {
+// Run in the output folder (drawWithGnuplot): names its files relative to it.
+std::string plotScript(const std::vector<int>& threads, const std::vector<int>& sweeps) {
   std::ostringstream gp;
   gp << "set terminal pngcairo size 900,600 font ',11'\n"
-     << "set output '" << (directory / "performance.png").string() << "'\n"
+     << "if (!exists('outfile')) outfile = 'performance.png'\nset output outfile\n"
      << "set logscale xy\nset grid\nset key top left\n"
      << "set xlabel 'particles (hang2, N x N)'\nset ylabel 'ms per simulated frame (1/60 s)'\n"
      << "set title 'hang2: wall time per frame against particle count'\n"
      << "plot ";
-  const std::string data = "'" + (directory / "performance.dat").string() + "'";
+  const std::string data = "'performance.dat'";
   int index = 0;
   for (int t : threads) {
     gp << (index ? ", " : "") << data << " index " << index << " with linespoints lw 2 pt 7 title 'Drape, " << t
@@ -422,8 +422,8 @@ int bench(const BenchArguments& input) {
     scene::writeFilesAtomically(
         {{directory / "performance.csv", csv.str()},
          {directory / "performance.dat", plotData(rows, arguments.threads, arguments.naiveIterations)},
-         {directory / "performance.gp", plotScript(directory, arguments.threads, arguments.naiveIterations)}});
-    drawWithGnuplot(directory / "performance.gp", directory / "performance.png");
+         {directory / "performance.gp", plotScript(arguments.threads, arguments.naiveIterations)}});
+    drawWithGnuplot(directory, "performance.gp", "performance.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {
       std::printf("wrote %s/performance.csv, performance.png%s%s\n", directory.c_str(), arguments.report ? " and " : "",

@@ -1,12 +1,19 @@
 #include "common.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <vector>
+
+#include <spawn.h>
+#include <sys/wait.h>
 
 #include "drape/scene/error.hpp"
 #include "drape/scene/gesture.hpp"
+#include "drape/scene/input.hpp"
+#include "drape/scene/output.hpp"
 
 namespace drape::cli {
 
@@ -59,12 +66,32 @@ void Playback::printReports() const {
   for (const std::string& report : replay_->reports()) std::cerr << "drape-cli: warning: " << report << "\n";
 }
 
-void drawWithGnuplot(const std::filesystem::path& script, const std::filesystem::path& picture) {
-  const std::string command = "gnuplot '" + script.string() + "'";
-  if (std::system(command.c_str()) != 0) {
-    throw scene::InputError("gnuplot could not draw " + picture.string() +
-                            " (is gnuplot installed? tools/setup installs it)");
+void drawWithGnuplot(const std::filesystem::path& directory, const std::string& script, const std::string& picture) {
+  const std::string shown = scene::printable((directory / picture).string(), 200);
+  // Drawn to a temporary of our own, renamed into place: the picture appears whole or not at all.
+  scene::OutputBatch batch;
+  const std::filesystem::path temporary = batch.reserve(directory / picture);
+  // No shell: gnuplot is started with its arguments as they are, in the folder, so no character
+  // of the folder's name is ever read as a command (the scripts name their files relative to it).
+  std::vector<std::string> words{"gnuplot", "-e", "outfile='" + temporary.filename().string() + "'", script};
+  std::vector<char*> argv;
+  for (std::string& word : words) argv.push_back(word.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addchdir_np(&actions, directory.c_str());
+  pid_t child = 0;
+  const int spawned = posix_spawnp(&child, "gnuplot", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  int status = 0;
+  if (spawned == 0) {
+    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+    }
   }
+  if (spawned != 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    throw scene::InputError("gnuplot could not draw " + shown + " (is gnuplot installed? tools/setup installs it)");
+  }
+  batch.commit();
 }
 
 int reportDivergence(const scene::Scene& scene, const sim::World& world) {

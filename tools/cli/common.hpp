@@ -50,8 +50,10 @@ class Playback {
   std::unique_ptr<interact::Replay> replay_;
 };
 
-// Runs gnuplot on `script`, which draws `picture`; throws scene::InputError if it cannot.
-void drawWithGnuplot(const std::filesystem::path& script, const std::filesystem::path& picture);
+// Runs gnuplot on `script` in `directory`, where the script's files are named relative to it; the
+// script draws to the file its variable `outfile` names, and this makes that `picture` (replaced
+// whole, or not at all). Throws scene::InputError if it cannot.
+void drawWithGnuplot(const std::filesystem::path& directory, const std::string& script, const std::string& picture);
 
 // Prints where the world diverged and returns kExitDiverged.
 int reportDivergence(const scene::Scene& scene, const sim::World& world);

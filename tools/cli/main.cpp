@@ -1,13 +1,31 @@
 // drape-cli: runs the Drape engine without a window. `drape-cli --help` lists the subcommands.
+#include <algorithm>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "drape/scene/input.hpp"
 
 namespace {
 
 using namespace drape::cli;
+
+// CLI11 reads "0x10" as hexadecimal and "010" as octal, and calls "1e3" out of range: a count on
+// our command line is decimal digits, and anything else says so.
+const CLI::Validator kDecimal(
+    [](std::string& text) -> std::string {
+      const std::size_t digits = text.rfind('-', 0) == 0 ? 1 : 0;
+      const bool ok = text.size() > digits && text.size() <= 18 + digits &&
+                      std::all_of(text.begin() + static_cast<std::ptrdiff_t>(digits), text.end(),
+                                  [](char c) { return c >= '0' && c <= '9'; });
+      if (!ok) return "expected a whole number in decimal digits, got " + drape::scene::printable(text, 40);
+      // Leading zeros would be read as octal: "010" is ten.
+      const std::size_t first = text.find_first_not_of('0', digits);
+      text.erase(digits, (first == std::string::npos ? text.size() - 1 : first) - digits);
+      return std::string();
+    },
+    "INT");
 
 void addSceneOptions(CLI::App* command, SceneArguments& arguments) {
   command->add_option("scene", arguments.scene, "Scene file, or the name of a shipped scene")->required();
@@ -16,6 +34,7 @@ void addSceneOptions(CLI::App* command, SceneArguments& arguments) {
 
 void addLengthOptions(CLI::App* command, std::optional<std::int64_t>& steps, std::optional<double>& seconds) {
   CLI::Option* stepsOption = command->add_option("--steps", steps, "Number of steps (default: the scene's duration)")
+                                 ->transform(kDecimal)
                                  ->check(CLI::Range(std::int64_t{0}, std::int64_t{1000000000}));
   command->add_option("--time", seconds, "Simulated seconds instead of --steps")
       ->check(CLI::Range(0.0, 1.0e6))
@@ -52,6 +71,7 @@ int main(int argc, char** argv) {
   addRunOutputs(runCommand, runArguments);
   CLI::Option* trace = runCommand->add_option("--trace", runArguments.trace, "Trace one particle: column,row");
   runCommand->add_option("--trace-cloth", runArguments.traceCloth, "Which cloth --trace refers to (default 0)")
+      ->transform(kDecimal)
       ->check(CLI::Range(0, 1000))
       ->needs(trace);
   CLI::Option* traceOut =
@@ -78,6 +98,7 @@ int main(int argc, char** argv) {
                             "auto, front, side, top, or yaw,pitch,distance[,x,y,z] in degrees and metres");
   CLI::Option* renderOut = renderCommand->add_option("--out", renderArguments.out, "PNG of the last step");
   CLI::Option* every = renderCommand->add_option("--every", renderArguments.every, "A PNG every K steps (and step 0)")
+                           ->transform(kDecimal)
                            ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000000}));
   CLI::Option* outDir = renderCommand->add_option("--out-dir", renderArguments.outDir, "Folder for the --every frames");
   every->needs(outDir);
@@ -99,6 +120,7 @@ int main(int argc, char** argv) {
   addLengthOptions(studyCommand, studyArguments.steps, studyArguments.seconds);
   studyCommand->add_option("--sweep", studyArguments.sweeps, "path=v1,v2,... (repeatable: every combination runs)");
   studyCommand->add_option("--repeats", studyArguments.repeats, "Timed runs per configuration (median)")
+      ->transform(kDecimal)
       ->check(CLI::Range(1, 100));
   studyCommand->add_option("--gesture", studyArguments.gesture, "Play this gesture script in every run");
   studyCommand
@@ -114,25 +136,31 @@ int main(int argc, char** argv) {
       "bench", "Time the solver on hang2 (N x N) and more scenes, against the naive baseline; write a report");
   benchCommand->add_option("--sizes", benchArguments.sizes, "hang2 side N, comma-separated (default 64,128,256)")
       ->delimiter(',')
+      ->transform(kDecimal)
       ->check(CLI::Range(2, 1024));
   benchCommand->add_option("--threads", benchArguments.threads, "Thread counts (default 1,2)")
       ->delimiter(',')
+      ->transform(kDecimal)
       ->check(CLI::Range(1, 64));
   benchCommand
       ->add_option("--naive-iterations", benchArguments.naiveIterations,
                    "The naive baseline's sweeps per frame (default 10,200; 0: no baseline)")
       ->delimiter(',')
+      ->transform(kDecimal)
       ->check(CLI::Range(0, 100000));
   benchCommand->add_option("--scenes", benchArguments.scenes, "More scenes to time (default drape-sphere,hang2-tear)")
       ->delimiter(',');
   benchCommand->add_option("--frames", benchArguments.frames, "Frames per run (default 120)")
+      ->transform(kDecimal)
       ->check(CLI::Range(1, 100000));
   benchCommand->add_option("--repeats", benchArguments.repeats, "Timed runs per case (median; default 5)")
+      ->transform(kDecimal)
       ->check(CLI::Range(1, 100));
   benchCommand
       ->add_option("--substeps", benchArguments.substeps,
                    "Substeps of Drape's hang2 solver (default: the cheapest sweep that keeps strain within 5 % at "
                    "every frame)")
+      ->transform(kDecimal)
       ->check(CLI::Range(1, 1000));
   benchCommand
       ->add_flag(
@@ -143,6 +171,7 @@ int main(int argc, char** argv) {
       ->add_option("--extra-line-steps", benchArguments.extraLineSteps,
                    "Drape's hang2 sweep: up to this many more line steps where an edge is still over 4 % "
                    "(extraLineSteps; default 4)")
+      ->transform(kDecimal)
       ->check(CLI::Range(0, 100));
   benchCommand->add_flag("--quick", benchArguments.quick,
                          "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps (each unless given)");

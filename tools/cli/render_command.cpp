@@ -128,19 +128,22 @@ int render(const RenderArguments& arguments) {
       // A sequence keeps one camera, framed on the first frame, so the cloth moves and not the view.
       std::error_code error;
       std::filesystem::create_directories(*arguments.outDir, error);
-      if (!std::filesystem::is_directory(*arguments.outDir)) {
+      if (!std::filesystem::is_directory(*arguments.outDir, error)) {
         throw scene::InputError(*arguments.outDir + ": cannot create the folder for --out-dir");
       }
       const render::Camera camera = makeCamera(arguments.camera, world, aspect);
+      // Every frame or none: a run that diverges halfway leaves the folder as it was.
+      scene::OutputBatch frames;
       for (std::int64_t step = 0; step <= steps; ++step) {
         if (step > 0 && playback.step() == sim::StepStatus::diverged) return reportDivergence(scene, world);
         if (step % *arguments.every != 0) continue;
         char name[32];
         std::snprintf(name, sizeof name, "frame-%06lld.png", static_cast<long long>(step));
         const std::filesystem::path file = std::filesystem::path(*arguments.outDir) / name;
-        scene::writeFileAtomically(file, picture(camera));
+        frames.add(file, picture(camera));
         written.push_back(file.string());
       }
+      frames.commit();
     } else {
       for (std::int64_t step = 0; step < steps; ++step) {
         if (playback.step() == sim::StepStatus::diverged) return reportDivergence(scene, world);

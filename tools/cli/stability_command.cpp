@@ -42,10 +42,11 @@ BoundCells boundCells(std::optional<double> largest, bool hasBound, double theor
   return cells;
 }
 
-std::string plotScript(const std::filesystem::path& directory) {
+// Run in the output folder (drawWithGnuplot): names its files relative to it.
+std::string plotScript() {
   std::ostringstream gp;
   gp << "set terminal pngcairo size 1500,360 font ',10'\n"
-     << "set output '" << (directory / "stability.png").string() << "'\n"
+     << "if (!exists('outfile')) outfile = 'stability.png'\nset output outfile\n"
      << "set datafile separator ','\n"
      << "set multiplot layout 1,5 title 'Undamped oscillator, 1 kg on a spring: stable (green), damped (blue), "
         "diverged (red); line: linear theory dt = bound / omega'\n"
@@ -55,7 +56,7 @@ std::string plotScript(const std::filesystem::path& directory) {
   for (sim::Integrator integrator : kIntegrators) {
     const std::string name(sim::name(integrator));
     gp << "set title '" << name << "'\n"
-       << "plot '" << (directory / "stability.csv").string() << "' using ((strcol(1) eq '" << name
+       << "plot 'stability.csv' using ((strcol(1) eq '" << name
        << "') ? $3 : 1/0):2:(strcol(5) eq 'stable' ? 0x2ca02c : strcol(5) eq 'damped' ? 0x1f77b4 : 0xd62728) "
           "with points pt 5 ps 0.6 lc rgb variable";
     if (const auto bound = analysis::theoreticalStableOmegaDt(integrator)) {
@@ -75,7 +76,7 @@ int stability(const StabilityArguments& arguments) {
     const fs::path directory = arguments.outDir;
     std::error_code error;
     fs::create_directories(directory, error);
-    if (!fs::is_directory(directory))
+    if (!fs::is_directory(directory, error))
       throw scene::InputError(arguments.outDir + ": cannot create the folder for --out-dir");
 
     std::ostringstream map, boundaries, report;
@@ -181,8 +182,8 @@ int stability(const StabilityArguments& arguments) {
                                  {directory / "position.csv", positionMap.str()},
                                  {directory / "stability.csv", map.str()},
                                  {directory / "boundaries.csv", boundaries.str()},
-                                 {directory / "stability.gp", plotScript(directory)}});
-    drawWithGnuplot(directory / "stability.gp", directory / "stability.png");
+                                 {directory / "stability.gp", plotScript()}});
+    drawWithGnuplot(directory, "stability.gp", "stability.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {
       std::printf("%s", report.str().c_str());

@@ -125,7 +125,7 @@ int study(const StudyArguments& arguments) {
     const fs::path directory = arguments.outDir;
     std::error_code error;
     fs::create_directories(directory, error);
-    if (!fs::is_directory(directory))
+    if (!fs::is_directory(directory, error))
       throw scene::InputError(arguments.outDir + ": cannot create the folder for --out-dir");
 
     // The reference: 8x the substeps and 4x the iterations; refining once more (16x, 8x) shows
@@ -201,14 +201,16 @@ int study(const StudyArguments& arguments) {
       csv << '"' << r.label << "\"," << r.time << ',' << r.strainMax << ',' << r.strainMean << ',' << r.error << ','
           << (r.pareto ? 1 : 0) << ',' << (&r == chosen ? 1 : 0) << '\n';
     }
-    gp << "set terminal pngcairo size 900,600 font ',10'\nset output '" << (directory / "accuracy.png").string()
-       << "'\nset datafile separator ','\nset logscale xy\nset key top right\n"
+    // Run in the output folder (drawWithGnuplot): its files are named relative to it.
+    gp << "set terminal pngcairo size 900,600 font ',10'\n"
+       << "if (!exists('outfile')) outfile = 'accuracy.png'\nset output outfile\nset datafile separator ','\nset "
+          "logscale xy\nset key top right\n"
        << "set xlabel 'CPU time per simulated second (s)'\nset ylabel '"
        << (arguments.noReference ? "worst structural strain over the run" : "RMS distance from the reference (m)")
        << "'\n"
        << "set title '" << base.name << ": error against run time (Pareto front joined)'\n";
     const int y = arguments.noReference ? 3 : 5;
-    gp << "plot '" << (directory / "accuracy.csv").string() << "' skip 1 using 2:" << y
+    gp << "plot 'accuracy.csv' skip 1 using 2:" << y
        << " with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'configurations', \\\n"
        << "     '' skip 1 using 2:($6 == 1 ? $" << y
        << " : 1/0) smooth unique with linespoints pt 7 ps 1.6 lw 2 lc rgb "
@@ -313,7 +315,7 @@ int study(const StudyArguments& arguments) {
     report << " --out-dir " << arguments.outDir << (arguments.report ? " --report " + *arguments.report : "") << "`\n";
 
     scene::writeFilesAtomically({{directory / "accuracy.csv", csv.str()}, {directory / "accuracy.gp", gp.str()}});
-    drawWithGnuplot(directory / "accuracy.gp", directory / "accuracy.png");
+    drawWithGnuplot(directory, "accuracy.gp", "accuracy.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) std::printf("%s", report.str().c_str());
     return kExitOk;

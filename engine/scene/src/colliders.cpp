@@ -8,6 +8,8 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "drape/scene/error.hpp"
+#include "drape/scene/input.hpp"
+#include "drape/scene/obj.hpp"
 
 namespace drape::scene {
 
@@ -22,45 +24,63 @@ std::shared_ptr<const sim::TriangleMesh> loadObj(ObjectReader& reader, const std
   const std::string file = reader.text("file", "");
   if (file.empty()) reader.fail("file", "the path of an OBJ file (relative to the scene file)", reader.raw("file"));
   const std::filesystem::path path = std::filesystem::path(sceneSource).parent_path() / file;
+  const std::string what =
+      reader.source() + ": " + reader.pathOf("file") + ": cannot use the OBJ file " + printable(path.string(), 200);
+  std::string text;
+  try {
+    text = readInputFile(path, "OBJ file", kMaxMeshFileBytes);
+  } catch (const InputError& error) {
+    // "PATH: cannot open the OBJ file: WHY" -> "SCENE: KEY: cannot use the OBJ file PATH: WHY"
+    const std::string message = error.what();
+    const std::size_t why = message.find("OBJ file: ");
+    throw InputError(what + ": " + (why == std::string::npos ? message : message.substr(why + 10)));
+  }
+  return parseObj(text, what, scale);
+}
+
+}  // namespace
+
+std::shared_ptr<const sim::TriangleMesh> parseObj(std::string_view text, const std::string& what, double scale) {
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
   tinyobj::ObjReader obj;
-  const bool ok = std::filesystem::is_regular_file(path) && obj.ParseFromFile(path.string(), config);
-  auto mesh = std::make_shared<sim::TriangleMesh>();
-  if (ok) {
-    const std::vector<tinyobj::real_t>& v = obj.GetAttrib().vertices;
-    for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
-      mesh->vertices.push_back(sim::Vec3{v[i], v[i + 1], v[i + 2]} * scale);
-    }
-    for (const tinyobj::shape_t& shape : obj.GetShapes()) {
-      const auto& indices = shape.mesh.indices;
-      for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
-        const int a = indices[i].vertex_index, b = indices[i + 1].vertex_index, c = indices[i + 2].vertex_index;
-        const auto count = static_cast<int>(mesh->vertices.size());
-        if (a < 0 || b < 0 || c < 0 || a >= count || b >= count || c >= count) {
-          throw InputError(reader.source() + ": " + reader.pathOf("file") + ": cannot use the OBJ file " +
-                           path.string() + ": a face refers to a vertex it does not have");
-        }
-        mesh->triangles.push_back({a, b, c});
-      }
-    }
-  }
-  bool finiteVertices = true;
-  for (const sim::Vec3& p : mesh->vertices) finiteVertices = finiteVertices && std::isfinite(p.x + p.y + p.z);
-  if (!ok || mesh->triangles.empty() || !finiteVertices) {
-    std::string why = !std::filesystem::is_regular_file(path) ? "it does not exist"
-                      : !ok                                   ? obj.Error()
-                                                              : "it has no triangles";
-    if (!finiteVertices) why = "it has non-finite vertices";
+  // From memory, with an empty material library: an `mtllib` line names nothing we open.
+  if (!obj.ParseFromString(std::string(text), "", config)) {
+    std::string why = obj.Error();
     for (char& ch : why) ch = ch == '\n' ? ' ' : ch;
-    throw InputError(reader.source() + ": " + reader.pathOf("file") + ": cannot use the OBJ file " + path.string() +
-                     ": " + why);
+    throw InputError(what + ": " + printable(why, 200));
   }
+  auto mesh = std::make_shared<sim::TriangleMesh>();
+  const std::vector<tinyobj::real_t>& v = obj.GetAttrib().vertices;
+  mesh->vertices.reserve(v.size() / 3);
+  for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
+    const sim::Vec3 p = sim::Vec3{v[i], v[i + 1], v[i + 2]} * scale;
+    // Beyond this the collider's grid could not hold the mesh (and no scene reaches it).
+    if (!(std::abs(p.x) <= kMaxMeshCoordinate && std::abs(p.y) <= kMaxMeshCoordinate &&
+          std::abs(p.z) <= kMaxMeshCoordinate)) {
+      throw InputError(what + ": vertex " + std::to_string(i / 3 + 1) + " lies beyond +-" +
+                       std::to_string(static_cast<int>(kMaxMeshCoordinate)) + " m (after scale), or is not finite");
+    }
+    mesh->vertices.push_back(p);
+  }
+  const auto count = static_cast<long long>(mesh->vertices.size());
+  for (const tinyobj::shape_t& shape : obj.GetShapes()) {
+    const auto& indices = shape.mesh.indices;
+    for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
+      const long long a = indices[i].vertex_index, b = indices[i + 1].vertex_index, c = indices[i + 2].vertex_index;
+      if (a < 0 || b < 0 || c < 0 || a >= count || b >= count || c >= count) {
+        throw InputError(what + ": a face refers to a vertex it does not have");
+      }
+      if (mesh->triangles.size() == kMaxMeshTriangles) {
+        throw InputError(what + ": it has more than " + std::to_string(kMaxMeshTriangles) + " triangles");
+      }
+      mesh->triangles.emplace_back(a, b, c);
+    }
+  }
+  if (mesh->triangles.empty()) throw InputError(what + ": it has no triangles");
   return mesh;
 }
-
-}  // namespace
 
 sim::ColliderSettings readCollider(ObjectReader& reader, const std::string& sceneSource) {
   sim::ColliderSettings c;

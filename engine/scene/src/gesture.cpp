@@ -1,10 +1,12 @@
 #include "drape/scene/gesture.hpp"
 
 #include <cmath>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
 #include "drape/scene/error.hpp"
+#include "drape/sim/world.hpp"
 #include "json_reader.hpp"
 
 namespace drape::scene {
@@ -83,6 +85,7 @@ interact::GestureScript parseGesture(const json& document, const std::string& so
 
   const json& events = root.array("events", kMaxEvents);
   double previous = 0.0;
+  std::set<int> down;  // fingers down at this point of the script
   for (std::size_t i = 0; i < events.size(); ++i) {
     ObjectReader event(events[i], "events." + std::to_string(i), source);
     GestureEvent e;
@@ -103,6 +106,10 @@ interact::GestureScript parseGesture(const json& document, const std::string& so
     if (type == "down") {
       e.type = GestureEvent::Type::down;
       needFinger();
+      if (down.insert(e.finger).second && down.size() > static_cast<std::size_t>(sim::kMaxFingers)) {
+        event.fail("finger", "at most " + std::to_string(sim::kMaxFingers) + " fingers down at once",
+                   event.raw("finger"));
+      }
       e.pointer = readPointer(event, script.camera.has_value());
       if (event.has("radius")) e.radius = event.number("radius", 0.05, {0.0, 10.0, true, "m"});
     } else if (type == "move") {
@@ -112,6 +119,7 @@ interact::GestureScript parseGesture(const json& document, const std::string& so
     } else if (type == "up" || type == "pin") {
       e.type = type == "up" ? GestureEvent::Type::up : GestureEvent::Type::pin;
       needFinger();
+      down.erase(e.finger);
     } else if (type == "unpin") {
       e.type = GestureEvent::Type::unpin;
       e.pointer = readPointer(event, script.camera.has_value());
@@ -138,7 +146,7 @@ interact::GestureScript parseGesture(const json& document, const std::string& so
 }
 
 interact::GestureScript loadGesture(const std::filesystem::path& file) {
-  return parseGesture(readJsonFile(file, "gesture script"), file.string());
+  return parseGesture(readJsonFile(file, "gesture script", kMaxGestureFileBytes), file.string());
 }
 
 json gestureDocument(const interact::GestureScript& script) {

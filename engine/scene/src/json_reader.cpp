@@ -1,10 +1,8 @@
 #include "json_reader.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
-#include <vector>
 
 namespace drape::scene {
 
@@ -139,40 +137,13 @@ const nlohmann::json& ObjectReader::array(std::string_view key, std::size_t maxS
 void ObjectReader::finish() const {
   for (auto it = node_.begin(); it != node_.end(); ++it) {
     if (!read_.contains(it.key())) {
-      throw InputError(source_ + ": " + pathOf(it.key()) + ": unknown key");
+      throw InputError(source_ + ": " + pathOf(printable(it.key())) + ": unknown key");
     }
   }
 }
 
-json readJsonFile(const std::filesystem::path& file, std::string_view what) {
-  const std::string source = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in || std::filesystem::is_directory(file)) throw InputError(source + ": cannot open the " + std::string(what));
-  std::ostringstream text;
-  text << in.rdbuf();
-  // JSON allows a key twice in one object and keeps the last; a file that does so has a mistake in
-  // it, so it is refused rather than silently half-read.
-  std::vector<std::set<std::string>> keysSeen;
-  const json::parser_callback_t rejectDuplicateKeys = [&](int depth, json::parse_event_t event, json& parsed) {
-    // Deeper than any file of ours: refused before anything recursive (printing, copying) meets it.
-    if (depth > 64) throw InputError(source + ": nested more than 64 levels deep");
-    if (event == json::parse_event_t::object_start) keysSeen.emplace_back();
-    if (event == json::parse_event_t::object_end && !keysSeen.empty()) keysSeen.pop_back();
-    if (event == json::parse_event_t::key && !keysSeen.empty() &&
-        !keysSeen.back().insert(parsed.get<std::string>()).second) {
-      throw InputError(source + ": key " + describe(parsed) + " appears twice in one object");
-    }
-    return true;
-  };
-  try {
-    return json::parse(text.str(), rejectDuplicateKeys);
-  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e999
-    // nlohmann's messages start with a tag: "[json.exception.parse_error.101] parse error at line 3, ..."
-    std::string message = e.what();
-    const std::size_t tagEnd = message.find("] ");
-    if (tagEnd != std::string::npos) message = message.substr(tagEnd + 2);
-    throw InputError(source + ": malformed JSON: " + message);
-  }
+json readJsonFile(const std::filesystem::path& file, std::string_view what, std::size_t maxBytes) {
+  return parseJson(readInputFile(file, what, maxBytes), printable(file.string(), 200));
 }
 
 }  // namespace drape::scene

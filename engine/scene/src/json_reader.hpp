@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/scene/error.hpp"
+#include "drape/scene/input.hpp"
 #include "drape/sim/types.hpp"
 
 namespace drape::scene {
@@ -59,8 +60,9 @@ class ObjectReader {
                          const nlohmann::json* got);
 std::string describe(const nlohmann::json& value);
 std::string formatRange(const Range& range);
-// Reads a JSON file, refusing duplicate keys; `what` names it in messages ("scene file"). Throws InputError.
-nlohmann::json readJsonFile(const std::filesystem::path& file, std::string_view what);
+// Reads a JSON file of at most maxBytes strictly (drape/scene/input.hpp); `what` names it in
+// messages ("scene file"). Throws InputError.
+nlohmann::json readJsonFile(const std::filesystem::path& file, std::string_view what, std::size_t maxBytes);
 
 // Reads [x, y, z] at `path`.
 sim::Vec3 readVec3(const nlohmann::json& value, const std::string& path, const std::string& source, double maxAbs,

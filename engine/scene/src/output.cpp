@@ -1,66 +1,126 @@
 #include "drape/scene/output.hpp"
 
-#include <cstdio>
-#include <fstream>
+#include <cerrno>
+#include <cstring>
 #include <sstream>
 #include <system_error>
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "drape/scene/error.hpp"
+#include "drape/scene/input.hpp"
 #include "drape/sim/metrics.hpp"
 
 namespace drape::scene {
 
 namespace {
 
-std::filesystem::path temporaryName(const std::filesystem::path& file) {
-  std::filesystem::path temporary = file;
-  temporary += ".part";
-  return temporary;
+namespace fs = std::filesystem;
+
+std::string reason(int error) {
+  switch (error) {
+    case ENOENT: return "its folder does not exist";
+    case ENOTDIR: return "a folder on its path is a file";
+    case EACCES:
+    case EPERM: return "permission denied";
+    case ENAMETOOLONG: return "the name is too long";
+    case ENOSPC: return "the disk is full";
+    case EROFS: return "the file system is read-only";
+    default: return std::strerror(error);
+  }
 }
 
-void removeTemporaries(const std::vector<OutputFile>& files, std::size_t count) {
-  std::error_code ignored;
-  for (std::size_t i = 0; i < count; ++i) std::filesystem::remove(temporaryName(files[i].path), ignored);
+// A new file beside `target` that nobody else has: created exclusively and not through a link
+// (O_EXCL fails on any existing name, a planted symbolic link included), named from the target's
+// first characters, the process and a counter, so that a name of 255 characters still has room.
+struct Temporary {
+  fs::path path;
+  int fd = -1;
+};
+
+Temporary createTemporary(const fs::path& target) {
+  static unsigned counter = 0;
+  const std::string stem = target.filename().string().substr(0, 64);
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    Temporary t;
+    t.path = target.parent_path() /
+             ("." + stem + "." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ".part");
+    t.fd = ::open(t.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (t.fd >= 0) return t;
+    if (errno != EEXIST) throw InputError(printable(target.string(), 200) + ": cannot write: " + reason(errno));
+  }
+  throw InputError(printable(target.string(), 200) + ": cannot write: no free temporary name beside it");
+}
+
+bool writeAll(int fd, std::string_view bytes) {
+  while (!bytes.empty()) {
+    const ssize_t done = ::write(fd, bytes.data(), bytes.size());
+    if (done < 0 && errno == EINTR) continue;
+    if (done <= 0) return false;
+    bytes.remove_prefix(static_cast<std::size_t>(done));
+  }
+  return true;
+}
+
+void refuseUnwritable(const std::filesystem::path& file) {
+  const std::string name = printable(file.string(), 200);
+  struct stat status {};
+  const bool exists = ::stat(file.c_str(), &status) == 0;
+  if (file.filename().empty() || file.filename() == "." || file.filename() == "..") {
+    throw InputError(name + ": cannot write: not a file name");
+  }
+  if (exists && S_ISDIR(status.st_mode)) throw InputError(name + ": cannot write: it is a folder");
+  // Renaming over /dev/null or a FIFO would put a plain file in its place.
+  if (exists && !S_ISREG(status.st_mode)) {
+    throw InputError(name + ": cannot write: it is not a regular file (a device, FIFO or socket)");
+  }
 }
 
 }  // namespace
 
+std::filesystem::path OutputBatch::reserve(const std::filesystem::path& file) {
+  refuseUnwritable(file);
+  const Temporary t = createTemporary(file);
+  entries_.push_back({file, t.path});
+  ::close(t.fd);
+  return t.path;
+}
+
+void OutputBatch::add(const std::filesystem::path& file, std::string_view contents) {
+  refuseUnwritable(file);
+  const std::string name = printable(file.string(), 200);
+  Temporary t = createTemporary(file);
+  entries_.push_back({file, t.path});
+  const bool written = writeAll(t.fd, contents);
+  const int writeError = errno;
+  const bool closed = ::close(t.fd) == 0;
+  if (!written || !closed) throw InputError(name + ": cannot write: " + reason(written ? errno : writeError));
+}
+
+void OutputBatch::commit() {
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    if (::rename(entries_[i].temporary.c_str(), entries_[i].target.c_str()) != 0) {
+      const int error = errno;
+      const std::string name = printable(entries_[i].target.string(), 200);
+      entries_.erase(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(i));  // those are in place
+      throw InputError(name + ": cannot write: " + reason(error));
+    }
+  }
+  entries_.clear();
+}
+
+OutputBatch::~OutputBatch() {
+  for (const Entry& e : entries_) ::unlink(e.temporary.c_str());
+}
+
 void writeFilesAtomically(const std::vector<OutputFile>& files) {
-  namespace fs = std::filesystem;
-  for (std::size_t i = 0; i < files.size(); ++i) {
-    const fs::path& file = files[i].path;
-    const std::string name = file.string();
-    std::error_code error;
-    std::string problem;
-    if (file.filename().empty()) {
-      problem = "not a file name";
-    } else if (fs::is_directory(file, error)) {
-      problem = "it is a directory";
-    } else {
-      std::ofstream out(temporaryName(file), std::ios::binary | std::ios::trunc);
-      if (!out) {
-        problem = "the directory is missing or not writable";
-      } else {
-        out.write(files[i].contents.data(), static_cast<std::streamsize>(files[i].contents.size()));
-        out.flush();
-        if (!out) problem = "the write failed (disk full?)";
-      }
-    }
-    if (!problem.empty()) {
-      removeTemporaries(files, i + 1);
-      throw InputError(name + ": cannot write: " + problem);
-    }
-  }
-  for (std::size_t i = 0; i < files.size(); ++i) {
-    std::error_code error;
-    fs::rename(temporaryName(files[i].path), files[i].path, error);
-    if (error) {
-      removeTemporaries(files, files.size());
-      throw InputError(files[i].path.string() + ": cannot write: " + error.message());
-    }
-  }
+  OutputBatch batch;
+  for (const OutputFile& file : files) batch.add(file.path, file.contents);
+  batch.commit();
 }
 
 void writeFileAtomically(const std::filesystem::path& file, std::string_view contents) {

@@ -267,16 +267,36 @@ Scene parseScene(const json& document, const std::string& source) {
   return scene;
 }
 
+namespace {
+
+// Levels of objects and arrays in `value` (0 for a number or string). The value was parsed within
+// kMaxJsonDepth, so the recursion is bounded.
+int depthOf(const json& value) {
+  int deepest = 0;
+  if (value.is_structured()) {
+    for (const json& element : value) deepest = std::max(deepest, depthOf(element));
+    return deepest + 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
 void applyOverride(json& document, std::string_view assignment) {
-  const std::string where = "--set " + std::string(assignment);
+  const std::string where = "--set " + printable(assignment, 120);
   const std::size_t equals = assignment.find('=');
   if (equals == std::string_view::npos || equals == 0) {
     throw InputError(where + ": expected path=value, e.g. cloths.0.grid.columns=64");
   }
   const std::string_view path = assignment.substr(0, equals);
   const std::string_view valueText = assignment.substr(equals + 1);
-  json value = json::parse(valueText, nullptr, false);
-  if (value.is_discarded()) value = std::string(valueText);
+  // JSON where it is JSON (as strictly as a file: no key twice, no deep nesting), else a string.
+  const json value = json::accept(valueText) ? parseJson(valueText, where) : json(std::string(valueText));
+  // The path's keys nest the value as deep as a file's objects would: the same limit.
+  const auto segments = static_cast<int>(std::count(path.begin(), path.end(), '.')) + 1;
+  if (segments + depthOf(value) > kMaxJsonDepth) {
+    throw InputError(where + ": nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
+  }
 
   json* node = &document;
   std::size_t begin = 0;
@@ -290,14 +310,14 @@ void applyOverride(json& document, std::string_view assignment) {
       std::size_t index = 0;
       const auto [end, error] = std::from_chars(segment.data(), segment.data() + segment.size(), index);
       if (error != std::errc{} || end != segment.data() + segment.size() || index >= node->size()) {
-        throw InputError(where + ": " + std::string(segment) + " is not an index of an array of " +
+        throw InputError(where + ": " + printable(segment) + " is not an index of an array of " +
                          std::to_string(node->size()));
       }
       next = &(*node)[index];
     } else if (node->is_object() || node->is_null()) {
       next = &(*node)[std::string(segment)];
     } else {
-      throw InputError(where + ": cannot go into " + describe(*node) + " at " + std::string(segment));
+      throw InputError(where + ": cannot go into " + describe(*node) + " at " + printable(segment));
     }
     if (dot == std::string_view::npos) {
       *next = value;
@@ -378,18 +398,20 @@ sim::ClothSettings drawnClothTemplate(const Scene& scene) {
 std::filesystem::path sceneDirectory() { return std::filesystem::path(DRAPE_ASSET_DIR) / "scenes"; }
 
 std::filesystem::path resolveScenePath(const std::string& nameOrPath) {
+  // Never throws: a name the file system refuses (too long, say) is left for the reader to report.
+  std::error_code ignored;
   const std::filesystem::path direct(nameOrPath);
-  if (std::filesystem::exists(direct)) return direct;
+  if (std::filesystem::exists(direct, ignored)) return direct;
   if (direct.parent_path().empty()) {
     std::filesystem::path shipped = sceneDirectory() / direct;
     if (!shipped.has_extension()) shipped += ".json";
-    if (std::filesystem::exists(shipped)) return shipped;
+    if (std::filesystem::exists(shipped, ignored)) return shipped;
   }
   return direct;
 }
 
 Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  json document = readJsonFile(file, "scene file");
+  json document = readJsonFile(file, "scene file", kMaxSceneFileBytes);
   for (const std::string& assignment : overrides) applyOverride(document, assignment);
   return parseScene(document, file.string());
 }

@@ -85,8 +85,10 @@ json snapshotDocument(const Scene& scene, const sim::World& world) {
 }
 
 Snapshot loadSnapshot(const std::filesystem::path& file) {
-  const std::string source = file.string();
-  const json document = readJsonFile(file, "snapshot");
+  return parseSnapshot(readJsonFile(file, "snapshot", kMaxSnapshotFileBytes), file.string());
+}
+
+Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source) {
   ObjectReader root(document, "", source);
   if (root.integer("drapeSnapshot", 0, kFormat, kFormat) != kFormat) root.fail("drapeSnapshot", "1", nullptr);
   Snapshot snapshot;

@@ -4,21 +4,20 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace drape::scene {
 
+// `text` as it may appear in a one-line message: bytes that are not printable ASCII or valid UTF-8
+// (a newline, a stray byte of a binary file) become '?', and text longer than maxBytes is cut there
+// with "...". For whatever a message quotes of the user's input: keys, values, paths.
+std::string printable(std::string_view text, std::size_t maxBytes = 80);
+
 class InputError : public std::runtime_error {
  public:
-  // Control characters (a key or file name with a newline in it) become '?': one line, always.
-  explicit InputError(const std::string& message) : std::runtime_error(oneLine(message)) {}
-
- private:
-  static std::string oneLine(std::string text) {
-    for (char& c : text) {
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-    }
-    return text;
-  }
+  // One line, always, and never more than a screenful: the parts quoting input are cut shorter
+  // where they are made; this is the last line of defence.
+  explicit InputError(const std::string& message) : std::runtime_error(printable(message, 2000)) {}
 };
 
 }  // namespace drape::scene

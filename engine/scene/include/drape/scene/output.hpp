@@ -20,6 +20,29 @@ struct OutputFile {
   std::string contents;
 };
 
+// Files written one by one to temporary names beside their targets (each created exclusively,
+// never through a link), and renamed into place together by commit(). A batch destroyed before
+// commit() removes what it wrote: a failed run leaves the old files as they were. A target that
+// is a folder, device, FIFO or socket is refused. add() and commit() throw InputError naming the
+// file.
+class OutputBatch {
+ public:
+  OutputBatch() = default;
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+  ~OutputBatch();
+  void add(const std::filesystem::path& file, std::string_view contents);
+  // The temporary that will become `file`, created empty, for another program to write.
+  std::filesystem::path reserve(const std::filesystem::path& file);
+  void commit();
+
+ private:
+  struct Entry {
+    std::filesystem::path target, temporary;
+  };
+  std::vector<Entry> entries_;
+};
+
 // Writes every file or none: all go to temporary names first, and are renamed into place only
 // when all were written. Throws InputError naming the file that could not be written.
 void writeFilesAtomically(const std::vector<OutputFile>& files);

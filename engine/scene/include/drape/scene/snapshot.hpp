@@ -22,6 +22,8 @@ struct Snapshot {
 
 nlohmann::json snapshotDocument(const Scene& scene, const sim::World& world);
 Snapshot loadSnapshot(const std::filesystem::path& file);
+// Validates an already parsed snapshot; `source` names it in messages. Throws InputError.
+Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source);
 
 // A world made from the snapshot: the scene's world with its cloths put back. Throws InputError.
 sim::World makeWorld(const Snapshot& snapshot);
