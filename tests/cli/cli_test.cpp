@@ -205,6 +205,45 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"NestedTooDeep", deeplyNested(), "", "bad.json: nested more than 64 levels deep"}),
     [](const auto& testInfo) { return std::string(testInfo.param.name); });
 
+TEST_F(Cli, RunCountsIntersectingTrianglePairsEveryKStepsAndInTheState) {
+  // A sheet lying flat and a second one standing through it, in no gravity: the same crossing at
+  // every step, and none in either sheet alone.
+  json crossing = json::parse(R"({"gravity": [0, 0, 0], "cloths": [
+    {"grid": {"columns": 9, "rows": 9, "width": 1, "height": 1}, "origin": [-0.5, 1, -0.5], "plane": "xz"},
+    {"grid": {"columns": 7, "rows": 5, "width": 0.8, "height": 0.6}, "origin": [-0.41, 1.23, -0.137], "plane": "xy"}]})");
+  const fs::path scene = write("crossing.json", crossing.dump());
+  const fs::path csv = file("pairs.csv"), state = file("s.json");
+  const Result result = run("run '" + scene.string() + "' --steps 25 --intersections-every 10 --intersections-out '" +
+                            csv.string() + "' --out '" + state.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::istringstream rows(read(csv));
+  std::string line;
+  std::getline(rows, line);
+  EXPECT_EQ(line, "step,time,pairs,skipped");
+  std::vector<long long> steps, pairs;
+  while (std::getline(rows, line)) {
+    long long step = 0, count = 0, skipped = 0;
+    double time = 0.0;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lld,%lf,%lld,%lld", &step, &time, &count, &skipped), 4) << line;
+    steps.push_back(step);
+    pairs.push_back(count);
+    EXPECT_EQ(skipped, 0);
+  }
+  EXPECT_EQ(steps, (std::vector<long long>{0, 10, 20, 25}));
+  ASSERT_FALSE(pairs.empty());
+  EXPECT_GT(pairs[0], 10);  // 0.8 m of crossing over cells 12.5 and 13 cm wide: two pieces a cell
+  for (const long long p : pairs) EXPECT_EQ(p, pairs[0]);
+  EXPECT_EQ(json::parse(read(state))["metrics"]["intersections"]["pairs"], pairs[0]);
+  EXPECT_NE(result.out.find("intersecting triangle pairs: " + std::to_string(pairs[0]) + " at the end"),
+            std::string::npos)
+      << result.out;
+  // The flat sheet alone.
+  crossing["cloths"].erase(1);
+  write("crossing.json", crossing.dump());
+  ASSERT_EQ(run("run '" + scene.string() + "' --steps 5 --out '" + state.string() + "'").exitCode, 0);
+  EXPECT_EQ(json::parse(read(state))["metrics"]["intersections"]["pairs"], 0);
+}
+
 TEST_F(Cli, RenderWritesAPngOfTheRequestedSize) {
   const fs::path picture = file("hang.png");
   const Result result = run("render hang --steps 5 --size 64x48 --out '" + picture.string() + "'");

@@ -15,6 +15,7 @@
 #include "drape/scene/error.hpp"
 #include "drape/scene/output.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/sim/intersections.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 
@@ -133,6 +134,24 @@ int run(const RunArguments& arguments) {
       appendTraceRow(trace, world, *target);
     }
 
+    // Where cloth passes through cloth (sim/intersections.hpp), at step 0, every K steps and the last.
+    std::ostringstream intersections;
+    std::size_t worstPairs = 0, lastPairs = 0;
+    std::int64_t worstStep = 0;
+    const auto countIntersections = [&] {
+      const sim::IntersectionCount count = sim::countIntersections(world);
+      intersections << world.stepCount() << ',' << world.time() << ',' << count.pairs << ',' << count.skipped << '\n';
+      lastPairs = count.pairs;
+      if (count.pairs > worstPairs) {
+        worstPairs = count.pairs;
+        worstStep = world.stepCount();
+      }
+    };
+    if (arguments.intersectionsEvery) {
+      intersections << "step,time,pairs,skipped\n";
+      countIntersections();
+    }
+
     const auto start = std::chrono::steady_clock::now();
     for (std::int64_t i = 0; i < steps; ++i) {
       if (playback.step() == sim::StepStatus::diverged) {
@@ -140,6 +159,9 @@ int run(const RunArguments& arguments) {
         return reportDivergence(scene, world);
       }
       if (target) appendTraceRow(trace, world, *target);
+      if (arguments.intersectionsEvery && ((i + 1) % *arguments.intersectionsEvery == 0 || i + 1 == steps)) {
+        countIntersections();
+      }
     }
     playback.printReports();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -153,6 +175,7 @@ int run(const RunArguments& arguments) {
                : scene::objText(world)});
     }
     if (arguments.traceOut) files.push_back({*arguments.traceOut, trace.str()});
+    if (arguments.intersectionsOut) files.push_back({*arguments.intersectionsOut, intersections.str()});
     scene::writeFilesAtomically(files);
 
     if (!arguments.quiet) {
@@ -163,6 +186,10 @@ int run(const RunArguments& arguments) {
           "max %.2f %%, mean %.3f %%; energy %.4g J\n",
           scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds, world.cloths().size(),
           countParticles(world), countPieces(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
+      if (arguments.intersectionsEvery) {
+        std::printf("intersecting triangle pairs: %zu at the end, at most %zu (step %lld)\n", lastPairs, worstPairs,
+                    static_cast<long long>(worstStep));
+      }
       for (const scene::OutputFile& file : files) std::printf("wrote %s\n", file.path.c_str());
     }
     return kExitOk;

@@ -41,9 +41,18 @@ void addLengthOptions(CLI::App* command, std::optional<std::int64_t>& steps, std
       ->excludes(stepsOption);
 }
 
-// --out and --quiet of run and replay.
+// --out, --intersections-every/out and --quiet of run and replay.
 void addRunOutputs(CLI::App* command, RunArguments& arguments) {
   command->add_option("--out", arguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
+  CLI::Option* every = command
+                           ->add_option("--intersections-every", arguments.intersectionsEvery,
+                                        "Count intersecting triangle pairs at step 0, every K steps and the last step")
+                           ->transform(kDecimal)
+                           ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000000}));
+  CLI::Option* out = command->add_option("--intersections-out", arguments.intersectionsOut,
+                                         "CSV of the counts: step,time,pairs,skipped");
+  every->needs(out);
+  out->needs(every);
   command->add_flag("--quiet", arguments.quiet, "Print nothing on success");
 }
 

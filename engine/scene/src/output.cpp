@@ -13,6 +13,7 @@
 
 #include "drape/scene/error.hpp"
 #include "drape/scene/input.hpp"
+#include "drape/sim/intersections.hpp"
 #include "drape/sim/metrics.hpp"
 
 namespace drape::scene {
@@ -141,7 +142,9 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
   document["dt"] = world.settings().solver.dt;
   document["steps"] = world.stepCount();
   document["time"] = world.time();
+  const sim::IntersectionCount intersections = sim::countIntersections(world);
   document["metrics"] = {{"strain", {{"max", strain.max}, {"mean", strain.mean}, {"constraints", strain.count}}},
+                         {"intersections", {{"pairs", intersections.pairs}, {"skipped", intersections.skipped}}},
                          {"energy",
                           {{"kinetic", energy.kinetic},
                            {"gravitational", energy.gravitational},
