@@ -6,6 +6,7 @@
 
 #include <imgui.h>
 
+#include "drape/sim/intersections.hpp"
 #include "drape/sim/metrics.hpp"
 
 namespace drape::app {
@@ -163,6 +164,11 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   panels.maxStrain.add(static_cast<float>(strain.max * 100.0));
   panels.meanStrain.add(static_cast<float>(strain.mean * 100.0));
   panels.energy.add(static_cast<float>(sim::energy(world).total()));
+  if (++panels.framesSinceCount >= PanelState::kIntersectionFrames) {
+    panels.framesSinceCount = 0;
+    panels.intersections = sim::countIntersections(world).pairs;
+  }
+  panels.intersectionHistory.add(static_cast<float>(panels.intersections));
   if (panels.stages.size() != world.profile().size()) {
     panels.stages.assign(world.profile().size(), History{});
     panels.stageNames.clear();
@@ -322,6 +328,13 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::Text("particles %zu   constraints %zu   torn %zu", particles, constraints, torn);
     ImGui::Text("cloths %zu   pieces %zu   fingers %zu   %.0f fps", world.cloths().size(), pieces,
                 world.fingers().size(), stats.fps.latest());
+    ImGui::Text("intersecting triangle pairs %zu", panels.intersections);
+    if (ImGui::IsItemHovered()) {
+      ImGui::SetTooltip(
+          "Pairs of triangles passing through each other (cloth through cloth), counted exactly every %d "
+          "frames; 0 when no cloth passes through itself or another",
+          PanelState::kIntersectionFrames);
+    }
     const ImVec2 plot(0.0f, 40.0f);
     char overlay[64];
     std::snprintf(overlay, sizeof overlay, "step %.2f ms/frame", stats.stepMilliseconds.latest());
@@ -339,6 +352,10 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     std::snprintf(overlay, sizeof overlay, "mean strain %.3f %%", panels.meanStrain.latest());
     ImGui::PlotLines("##mean", panels.meanStrain.data(), History::kLength, panels.meanStrain.offset(), overlay, 0.0f,
                      std::max(0.1f, panels.meanStrain.largest()), plot);
+    std::snprintf(overlay, sizeof overlay, "intersecting triangle pairs %zu", panels.intersections);
+    ImGui::PlotLines("##intersections", panels.intersectionHistory.data(), History::kLength,
+                     panels.intersectionHistory.offset(), overlay, 0.0f,
+                     std::max(1.0f, panels.intersectionHistory.largest()), plot);
     std::snprintf(overlay, sizeof overlay, "energy %.3g J", panels.energy.latest());
     ImGui::PlotLines("##energy", panels.energy.data(), History::kLength, panels.energy.offset(), overlay, FLT_MAX,
                      FLT_MAX, plot);

@@ -74,6 +74,12 @@ struct PanelState {
     return options;
   }();
   History maxStrain, meanStrain, energy;
+  // Intersecting triangle pairs (sim/intersections.hpp), counted every kIntersectionFrames frames:
+  // a count costs about a pass over the triangles, too much to take every frame on a fine cloth.
+  static constexpr int kIntersectionFrames = 10;
+  int framesSinceCount = kIntersectionFrames;
+  std::size_t intersections = 0;
+  History intersectionHistory;
   std::vector<History> stages;  // per stage of the world's pipeline, ms per frame
   std::vector<std::string> stageNames;
 };
