@@ -14,6 +14,7 @@
 #include "drape/scene/gesture.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/metrics.hpp"
+#include "played.hpp"
 
 namespace drape {
 namespace {
@@ -21,33 +22,8 @@ namespace {
 using sim::Real;
 using sim::Vec3;
 
-const std::filesystem::path kAssets = DRAPE_ASSET_DIR;
-
-// A scene with a gesture script playing on it, stepped as drape-cli replay steps it.
-struct Played {
-  scene::Scene scene;
-  std::unique_ptr<sim::World> world;
-  interact::GestureScript script;
-  std::unique_ptr<interact::Interaction> interaction;
-  std::unique_ptr<interact::Replay> replay;
-
-  Played(const std::string& sceneName, const std::string& gestureName)
-      : scene(scene::loadScene(kAssets / "scenes" / (sceneName + ".json"))),
-        world(std::make_unique<sim::World>(scene.world)),
-        script(scene::loadGesture(kAssets / "gestures" / (gestureName + ".json"))),
-        interaction(std::make_unique<interact::Interaction>(*world)),
-        replay(std::make_unique<interact::Replay>(*world, *interaction, script)) {
-    interaction->settings().material = scene::drawnClothTemplate(scene);
-  }
-
-  // Plays until `seconds` of simulated time (the script's length if not given).
-  void until(double seconds = -1.0) {
-    if (seconds < 0.0) seconds = script.length();
-    while (world->time() < seconds - 1e-9) ASSERT_EQ(replay->step(), sim::StepStatus::ok);
-    EXPECT_TRUE(replay->reports().empty()) << replay->reports().front();
-  }
-  const sim::Cloth& cloth(int index = 0) const { return world->cloths().at(static_cast<std::size_t>(index)); }
-};
+using test::kAssets;
+using test::Played;
 
 Vec3 centroid(const sim::Cloth& cloth) {
   Vec3 sum{0.0};

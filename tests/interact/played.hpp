@@ -1,0 +1,44 @@
+// A shipped scene with a shipped gesture script playing on it, stepped as drape-cli replay steps it.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "drape/interact/replay.hpp"
+#include "drape/scene/gesture.hpp"
+#include "drape/scene/scene.hpp"
+
+namespace drape::test {
+
+inline const std::filesystem::path kAssets = DRAPE_ASSET_DIR;
+
+// A scene with a gesture script playing on it, stepped as drape-cli replay steps it.
+struct Played {
+  scene::Scene scene;
+  std::unique_ptr<sim::World> world;
+  interact::GestureScript script;
+  std::unique_ptr<interact::Interaction> interaction;
+  std::unique_ptr<interact::Replay> replay;
+
+  Played(const std::string& sceneName, const std::string& gestureName)
+      : scene(scene::loadScene(kAssets / "scenes" / (sceneName + ".json"))),
+        world(std::make_unique<sim::World>(scene.world)),
+        script(scene::loadGesture(kAssets / "gestures" / (gestureName + ".json"))),
+        interaction(std::make_unique<interact::Interaction>(*world)),
+        replay(std::make_unique<interact::Replay>(*world, *interaction, script)) {
+    interaction->settings().material = scene::drawnClothTemplate(scene);
+  }
+
+  // Plays until `seconds` of simulated time (the script's length if not given).
+  void until(double seconds = -1.0) {
+    if (seconds < 0.0) seconds = script.length();
+    while (world->time() < seconds - 1e-9) ASSERT_EQ(replay->step(), sim::StepStatus::ok);
+    EXPECT_TRUE(replay->reports().empty()) << replay->reports().front();
+  }
+  const sim::Cloth& cloth(int index = 0) const { return world->cloths().at(static_cast<std::size_t>(index)); }
+};
+
+}  // namespace drape::test
