@@ -1,0 +1,114 @@
+// What the fuzz harnesses share: the libFuzzer entry point's declaration, how big a world one input
+// may make and step, and how a broken promise is reported (docs/fuzzing.md).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string_view>
+
+#include <glm/common.hpp>
+#include <nlohmann/json.hpp>
+
+#include "drape/sim/settings.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
+
+namespace drape::fuzz {
+
+// One input stays fast: a world of more particles is not built, and a world is stepped only as
+// far as this much work (particles times constraint sweeps, roughly) allows. Scenes beyond these
+// are legal but slow by design, not hostile.
+inline constexpr long long kMaxWorldParticles = 20000;
+// The outline builder alone: its bugs are in the geometry, which small cloths have as well.
+inline constexpr long long kMaxOutlineParticles = 3000;
+inline constexpr double kStepBudget = 2.0e5;
+
+inline std::string_view text(const std::uint8_t* data, std::size_t size) {
+  return {reinterpret_cast<const char*>(data), size};
+}
+
+// A promise of the code under test did not hold: said on stderr, then abort, so that libFuzzer
+// (or the replay) reports the input.
+[[noreturn]] inline void broken(const char* what, const char* detail = "") {
+  std::fprintf(stderr, "fuzz: broken promise: %s %s\n", what, detail);
+  std::abort();
+}
+
+// At most how many particles an outline fills, before it is built: the cloth's loop is made of
+// pieces of the closed stroke, so its perimeter is at most the stroke's length L, its area at most
+// L^2 / (4 pi) (and at most the stroke's bounding box); a particle per lattice cell of that area
+// plus a few per spacing of the border. Measured in spacings, so that a tiny spacing does not
+// underflow. Infinite when that is not a finite number (the engine must refuse those at once).
+inline double estimatedParticles(const sim::OutlineSpec& outline) {
+  if (outline.points.empty()) return 0.0;
+  const double s = outline.spacing;
+  glm::dvec2 lower = outline.points.front() / s, upper = lower;
+  double length = 0.0;
+  for (std::size_t i = 0; i < outline.points.size(); ++i) {
+    const glm::dvec2 p = outline.points[i] / s;
+    lower = glm::min(lower, p);
+    upper = glm::max(upper, p);
+    const glm::dvec2 d = outline.points[(i + 1) % outline.points.size()] / s - p;
+    length += std::sqrt(d.x * d.x + d.y * d.y);
+  }
+  const double box = (upper.x - lower.x + 2.0) * (upper.y - lower.y + 2.0);
+  const double area = std::min(box, length * length / (4.0 * 3.14159265358979323846));
+  const double estimate = area + 4.0 * length + static_cast<double>(outline.points.size());
+  return std::isfinite(estimate) ? estimate : HUGE_VAL;
+}
+
+// Particles a cloth will have, before it is built.
+inline double estimatedParticles(const sim::ClothSettings& cloth) {
+  if (cloth.outline) return estimatedParticles(*cloth.outline);
+  return static_cast<double>(cloth.lattice.columns) * static_cast<double>(cloth.lattice.rows);
+}
+
+// The same for the drawn cloths of a scene document, before it is read: reading a scene builds
+// each outline (to count its particles), so a short file with a wide outline is slow to read by
+// design. Looks only at what it understands; anything malformed is left to the reader.
+inline double estimatedOutlineParticles(const nlohmann::json& scene) {
+  double total = 0.0;
+  if (!scene.is_object() || !scene.contains("cloths") || !scene["cloths"].is_array()) return total;
+  for (const nlohmann::json& cloth : scene["cloths"]) {
+    if (!cloth.is_object() || !cloth.contains("outline") || !cloth["outline"].is_object()) continue;
+    const nlohmann::json& outline = cloth["outline"];
+    sim::OutlineSpec spec;
+    if (outline.contains("spacing") && outline["spacing"].is_number()) spec.spacing = outline["spacing"].get<double>();
+    // What the reader refuses before it builds (docs/scenes.md's ranges), it refuses at once.
+    if (!(spec.spacing >= 1.0e-3 && spec.spacing <= 10.0)) continue;
+    if (!outline.contains("points") || !outline["points"].is_array()) continue;
+    bool inRange = true;
+    for (const nlohmann::json& p : outline["points"]) {
+      if (p.is_array() && p.size() == 2 && p[0].is_number() && p[1].is_number()) {
+        spec.points.push_back({p[0].get<double>(), p[1].get<double>()});
+        inRange = inRange && std::abs(spec.points.back().x) <= 1.0e4 && std::abs(spec.points.back().y) <= 1.0e4;
+      }
+    }
+    if (inRange) total += estimatedParticles(spec);
+  }
+  return total;
+}
+
+inline double estimatedParticles(const sim::WorldSettings& world) {
+  double total = 0.0;
+  for (const sim::ClothSettings& cloth : world.cloths) total += estimatedParticles(cloth);
+  return total;
+}
+
+// How many of `wanted` steps fit the budget for a world of `particles` particles.
+inline int affordableSteps(const sim::WorldSettings& world, double particles, int wanted) {
+  const sim::SolverSettings& s = world.solver;
+  double sweeps = 4.0;  // the force model: RK4 evaluates the forces four times a substep
+  if (s.model == sim::Model::position) {
+    sweeps = std::max(1, s.iterations) * (1.0 + (s.lines ? 2.0 + s.extraLineSteps : 0.0)) + 1.0;
+  }
+  double perStep = std::max(1.0, particles) * std::max(1, s.substeps) * sweeps;
+  if (world.selfCollision.enabled) perStep *= 2.0;
+  return static_cast<int>(std::clamp(std::floor(kStepBudget / perStep), 0.0, static_cast<double>(wanted)));
+}
+
+}  // namespace drape::fuzz
