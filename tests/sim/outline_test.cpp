@@ -424,10 +424,14 @@ TEST(Outline, BadOutlinesSayWhy) {
   expectMessage({{}, 0.05, 0.0}, "fewer than 3 distinct points");
   expectMessage({{{0, 0}, {1, 1}, {2, 2}, {0.5, 0.5}}, 0.05, 0.0}, "no area");
   expectMessage({{{0, 0}, {1, 0}, {2, 0}, {0.5, 0}}, 0.05, 0.0}, "no area");
-  expectMessage({square(1.0), 0.0, 0.0}, "spacing must be positive");
-  expectMessage({square(1.0), -0.1, 0.0}, "spacing must be positive");
-  expectMessage({square(1.0), nan, 0.0}, "spacing must be positive");
-  expectMessage({square(1.0), inf, 0.0}, "spacing must be positive");
+  expectMessage({square(1.0), 0.0, 0.0}, "spacing must be at least 1e-09 m");
+  expectMessage({square(1.0), -0.1, 0.0}, "spacing must be at least 1e-09 m");
+  expectMessage({square(1.0), nan, 0.0}, "spacing must be at least 1e-09 m");
+  expectMessage({square(1.0), inf, 0.0}, "spacing must be at least 1e-09 m");
+  // So fine that a metre in the loop's grid units was infinite, cast to an integer (fuzz_outline's
+  // crashers: a subnormal and a normal double).
+  expectMessage({{{0.0, 0.0}, {1e-317, 0.0}, {0.0, 1e-317}}, 3.2e-319, 0.0}, "spacing must be at least 1e-09 m");
+  expectMessage({{{0.0, 0.0}, {1e-305, 0.0}, {0.0, 1e-305}}, 4.1e-307, 0.0}, "spacing must be at least 1e-09 m");
   expectMessage({square(1.0), 0.05, nan}, "height must be finite");
   expectMessage({{{0, 0}, {1, nan}, {1, 1}, {0, 1}}, 0.05, 0.0}, "non-finite point");
   expectMessage({{{0, 0}, {inf, 0}, {1, 1}, {0, 1}}, 0.05, 0.0}, "non-finite point");

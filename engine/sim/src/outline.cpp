@@ -37,6 +37,7 @@ using Coord = std::int64_t;
 __extension__ typedef __int128 Wide;  // GCC and Clang; __extension__ keeps -Wpedantic quiet
 
 constexpr Coord kUnitsPerSpacing = 4096;    // the lattice spacing in integer units
+constexpr double kMinSpacing = 1e-9;        // m
 constexpr Coord kMarginCells = 2;           // empty lattice cells around the stroke
 constexpr double kMaxSpanCells = 131072.0;  // 2^17: keeps coordinates below 2^30
 // Segment pairs the untangling may test, and steps the fill may take beyond its linear work, before the outline is
@@ -1375,8 +1376,10 @@ std::string tooSmall(double area, Real spacing) {
 
 // Rejects what cannot be an outline before anything is converted.
 void checkStroke(const OutlineSpec& spec) {
-  if (!std::isfinite(spec.spacing) || !(spec.spacing > 0.0)) {
-    fail("outline spacing must be positive and finite, not " + number(spec.spacing));
+  // From 1 nm: the loop's grid has 4096 units a spacing, and a metre in units (1 / unit) must stay
+  // finite (below about 2.3e-305 m it was infinity, cast to an integer: found by fuzz_outline).
+  if (!std::isfinite(spec.spacing) || !(spec.spacing >= kMinSpacing)) {
+    fail("outline spacing must be at least 1e-09 m and finite, not " + number(spec.spacing));
   }
   if (!std::isfinite(spec.height)) fail("outline height must be finite");
   const std::vector<glm::dvec2>& points = spec.points;

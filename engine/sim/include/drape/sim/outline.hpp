@@ -62,7 +62,7 @@ struct OutlineCloth {
 };
 
 // Builds the rest mesh of a cloth cut to the outline. Throws std::invalid_argument with a one-line message when the
-// outline cannot make a cloth: spacing or height not finite (spacing not positive), a non-finite point, fewer than 3
+// outline cannot make a cloth: spacing or height not finite (spacing under 1e-9 m), a non-finite point, fewer than 3
 // distinct points, no enclosed area (collinear points), smaller than one cell (area under spacing^2), wider than
 // 2^17 spacings, more particles than kMaxParticles (estimated from area and perimeter before anything is allocated;
 // the message says how many), or too intricate (so much detail finer than the spacing that untangling or filling it
