@@ -29,7 +29,7 @@ struct RunArguments {
   std::optional<std::string> trace;  // "column,row"
   int traceCloth = 0;
   std::optional<std::string> traceOut;
-  std::optional<std::string> gesture;  // a gesture script played while running
+  std::optional<std::string> gesture;              // a gesture script played while running
   std::optional<std::int64_t> intersectionsEvery;  // count intersecting triangle pairs every K steps ...
   std::optional<std::string> intersectionsOut;     // ... into this CSV
   bool quiet = false;
