@@ -31,8 +31,14 @@ struct IntersectionCount {
   std::size_t skipped = 0;  // triangles not tested (a corner non-finite or beyond 10^4 m)
 };
 IntersectionCount countIntersections(const std::vector<Vec3>& positions, const std::vector<glm::uvec3>& triangles);
+// As above, with which corners two triangles share told by `shared` (the same size as `triangles`):
+// a corner there names the particle it counts as.
+IntersectionCount countIntersections(const std::vector<Vec3>& positions, const std::vector<glm::uvec3>& triangles,
+                                     const std::vector<glm::uvec3>& shared);
 
-// Every cloth of the world together: pairs within a cloth and between cloths.
+// Every cloth of the world together: pairs within a cloth and between cloths. In a torn or cut
+// cloth, particles at one point of the grid count as one corner (the copies a tear makes, before
+// the seam opens: the triangles on its two sides touch there, as they did before it).
 IntersectionCount countIntersections(const World& world);
 
 }  // namespace drape::sim
