@@ -13,6 +13,7 @@
 #include "drape/interact/replay.hpp"
 #include "drape/scene/gesture.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/sim/intersections.hpp"
 #include "drape/sim/metrics.hpp"
 #include "played.hpp"
 
@@ -88,6 +89,8 @@ TEST(Gesture, TranslateDragsTheClothAlongWithTheFinger) {
   EXPECT_NEAR(moved.z, 0.1, 0.04);
   EXPECT_LT(highest(played.cloth()), 0.05);  // still lying on the table
   EXPECT_LT(sim::structuralStrain(*played.world).max, 0.1);
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, TranslateOnTheScreenMovesTheClothToTheRightOfThePicture) {
@@ -98,6 +101,8 @@ TEST(Gesture, TranslateOnTheScreenMovesTheClothToTheRightOfThePicture) {
   // The camera looks down from +z with x to the right of the picture.
   EXPECT_GT(moved.x, 0.15);
   EXPECT_LT(std::abs(moved.z), 0.05);
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, RotateTurnsTheClothAQuarterTurn) {
@@ -108,10 +113,17 @@ TEST(Gesture, RotateTurnsTheClothAQuarterTurn) {
     return std::atan2(-d.z, d.x);
   };
   const Real before = axis();
+  // Just before the fingers let go (at 1.9 s) the cloth has turned with them.
+  played.until(1.85);
+  EXPECT_NEAR(axis() - before, 3.14159265358979 / 2.0, 0.15);
+  // Let go, the wrinkles the turn raised fall, and the cloth turns back some way (measured 0.36 rad
+  // with self-contact between triangles, whose layers slide on each other): it stays turned.
   played.until();
-  const Real turned = axis() - before;
-  EXPECT_NEAR(turned, 3.14159265358979 / 2.0, 0.15);
+  EXPECT_GT(axis() - before, 3.14159265358979 / 4.0);
+  EXPECT_LT(axis() - before, 3.14159265358979 / 2.0 + 0.15);
   EXPECT_LT(glm::length(centroid(cloth) - Vec3{0.0, centroid(cloth).y, 0.0}), 0.05);  // about its middle
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, PinchLiftsWhatTheFingersHold) {
@@ -129,6 +141,8 @@ TEST(Gesture, PinchLiftsWhatTheFingersHold) {
   // The cloth hangs from the pinch: its far corners still lie on the table.
   EXPECT_LT(lowest(played.cloth()), 0.01);
   EXPECT_GT(highest(played.cloth()), 0.19);
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, CrumpleGathersTheClothIntoAPile) {
@@ -138,12 +152,16 @@ TEST(Gesture, CrumpleGathersTheClothIntoAPile) {
   // (measured 0.37-0.38 of it, whatever the rounding).
   played.until(1.85);
   EXPECT_LT(spread(played.cloth()), 0.5 * before) << spread(played.cloth()) << " from " << before;
-  // Let go, the pile relaxes, by how much is chaotic: a mass changed by 1e-7 of itself ends
-  // anywhere from 0.6 to 0.94 of the spread. It stays gathered, folded, and above the table.
-  played.until();
-  EXPECT_LT(spread(played.cloth()), 0.97 * before) << spread(played.cloth()) << " from " << before;
   EXPECT_GT(highest(played.cloth()), 0.03);  // folds rise out of the table
-  EXPECT_GT(lowest(played.cloth()), 0.0);    // none under it
+  EXPECT_EQ(sim::countIntersections(*played.world).pairs, 0u);
+  // Let go, the pile falls open: its layers slide on each other (Coulomb friction between them)
+  // and the compressed cloth springs back (its stretch constraints resist compression as they do
+  // stretch). It comes apart without passing through itself, and stays on the table.
+  played.until();
+  EXPECT_EQ(sim::countIntersections(*played.world).pairs, 0u);
+  EXPECT_GT(lowest(played.cloth()), 0.0);  // none under it
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, SpreadFlattensACrumpledCloth) {
@@ -154,6 +172,8 @@ TEST(Gesture, SpreadFlattensACrumpledCloth) {
   played.until();
   EXPECT_LT(highest(played.cloth()), 0.02);
   EXPECT_GT(footprint(played.cloth()), 0.85 * 0.36);
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, FoldLaysTheNearHalfOnTopOfTheFarHalf) {
@@ -175,9 +195,13 @@ TEST(Gesture, FoldLaysTheNearHalfOnTopOfTheFarHalf) {
       }
     }
   }
-  EXPECT_LT(nearEdgeZ, -0.15);                          // the near edge went over to the far side
-  EXPECT_GT(nearHalfY / near, farHalfY / far + 0.008);  // and lies on top
-  EXPECT_LT(highest(cloth), 0.08);                      // flat, in two layers
+  EXPECT_LT(nearEdgeZ, -0.15);  // the near edge went over to the far side
+  // and lies on top, a self-contact distance above
+  const Real distance = played.world->settings().selfCollision.distance;
+  EXPECT_NEAR(nearHalfY / near, farHalfY / far + distance, 0.2 * distance);
+  EXPECT_LT(highest(cloth), 0.08);  // flat, in two layers
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, LiftRaisesTheClothOffTheTable) {
@@ -187,6 +211,8 @@ TEST(Gesture, LiftRaisesTheClothOffTheTable) {
     EXPECT_NEAR(played.cloth().state.position[grip.particle].y, 0.505, 1e-6);
   }
   EXPECT_GT(lowest(played.cloth()), 0.02);  // all of it hangs in the air
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, DrapeLaysTheClothOverTheBall) {
@@ -197,11 +223,14 @@ TEST(Gesture, DrapeLaysTheClothOverTheBall) {
   Real closest = 1e9;
   for (const Vec3& x : cloth.state.position) closest = std::min(closest, glm::length(x - ball));
   EXPECT_GT(closest, 0.15 - 1e-3);  // nothing inside the ball
-  // Resting on its top: above it, at most a couple of layers (the self-collision distance, 2 cm) thick.
+  // Resting on its top: above it, a few layers (the self-contact distance apart) thick.
+  const Real distance = played.world->settings().selfCollision.distance;
   EXPECT_GT(highest(cloth), 0.3);
-  EXPECT_LT(highest(cloth), 0.3 + 0.005 + 2 * 0.02 + 0.005);
+  EXPECT_LT(highest(cloth), 0.3 + 0.005 + 8 * distance);
   EXPECT_NEAR(centroid(cloth).x, 0.5, 0.1);  // centred over it
   EXPECT_LT(lowest(cloth), 0.01);            // and down to the table around it
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, PinHoldsTheCornerUpUntilItIsTakenOut) {
@@ -215,6 +244,8 @@ TEST(Gesture, PinHoldsTheCornerUpUntilItIsTakenOut) {
   played.until();
   EXPECT_FALSE(cloth.state.pinned[corner]);
   EXPECT_LT(cloth.state.position[corner].y, 0.08);  // it fell back onto the table (onto the cloth, maybe)
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, TearRipsTheClothAndOnePieceIsPickedUpAlone) {
@@ -237,6 +268,8 @@ TEST(Gesture, TearRipsTheClothAndOnePieceIsPickedUpAlone) {
   EXPECT_GT(others, 100);
   EXPECT_EQ(onTable, others);  // every other piece stayed down
   EXPECT_NEAR(cloth.state.position[finger->grips.front().particle].y, 0.305, 1e-6);
+  // Not yet checked here: where the tear opens, its two sides still pass through each other at a
+  // few steps (9 pairs at worst, at step 55; issue 21's note).
 }
 
 TEST(Gesture, CutPartsTheClothAndOneHalfIsPickedUpAlone) {
@@ -252,6 +285,8 @@ TEST(Gesture, CutPartsTheClothAndOneHalfIsPickedUpAlone) {
     }
   }
   EXPECT_GT(highest(cloth), 0.25);
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, DrawMakesAClothOfTheOutlinesShapeThatCanBePickedUp) {
@@ -268,6 +303,8 @@ TEST(Gesture, DrawMakesAClothOfTheOutlinesShapeThatCanBePickedUp) {
   played.until();
   ASSERT_NE(played.world->finger(2), nullptr);
   EXPECT_GT(highest(played.cloth()), 0.25);
+  // It never passed through itself (self-contact between triangles), at any step counted.
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }
 
 TEST(Gesture, BadEventsAreReportedAndSkipped) {

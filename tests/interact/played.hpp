@@ -10,6 +10,7 @@
 #include "drape/interact/replay.hpp"
 #include "drape/scene/gesture.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/sim/intersections.hpp"
 
 namespace drape::test {
 
@@ -32,10 +33,24 @@ struct Played {
     interaction->settings().material = scene::drawnClothTemplate(scene);
   }
 
+  // Intersecting triangle pairs (intersections.hpp), counted every kCountEvery steps as it plays:
+  // the most at any of them, and at which step.
+  static constexpr std::int64_t kCountEvery = 5;
+  std::size_t worstIntersections = 0;
+  std::int64_t worstStep = 0;
+
   // Plays until `seconds` of simulated time (the script's length if not given).
   void until(double seconds = -1.0) {
     if (seconds < 0.0) seconds = script.length();
-    while (world->time() < seconds - 1e-9) ASSERT_EQ(replay->step(), sim::StepStatus::ok);
+    while (world->time() < seconds - 1e-9) {
+      ASSERT_EQ(replay->step(), sim::StepStatus::ok);
+      if (world->stepCount() % kCountEvery != 0) continue;
+      const std::size_t pairs = sim::countIntersections(*world).pairs;
+      if (pairs > worstIntersections) {
+        worstIntersections = pairs;
+        worstStep = world->stepCount();
+      }
+    }
     EXPECT_TRUE(replay->reports().empty()) << replay->reports().front();
   }
   const sim::Cloth& cloth(int index = 0) const { return world->cloths().at(static_cast<std::size_t>(index)); }

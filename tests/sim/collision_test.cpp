@@ -251,7 +251,7 @@ TEST(SelfCollision, ACurtainFallingInAHeapLiesOnItselfInLayers) {
     cloth.material(ConstraintKind::bend) = {0.05, 0.0};
     settings.cloths.push_back(cloth);
     settings.colliders.push_back(plane({0, 0, 0}, {0.05, 1, 0.03}, 0.5));  // slightly tilted: it folds one way
-    settings.selfCollision = {selfCollision, 0.02, 0.2, 0.5};
+    settings.selfCollision = {selfCollision, SelfContactMethod::particles, 0.02, 0.2, 0.5};
     World world(settings);
     EXPECT_EQ(world.hasStage(Stage::selfCollide), selfCollision);
     EXPECT_EQ(world.run(180), StepStatus::ok);
@@ -280,7 +280,7 @@ WorldSettings clothDroppedOnCloth(bool selfCollision) {
   settings.colliders.push_back(plane({0, 0, 0}, {0, 1, 0}, 0.5));
   // Particles are points: the distance must be about the particle spacing (0.04 m), or particles
   // of one cloth slip through the gaps between those of the other.
-  settings.selfCollision = {selfCollision, 0.045, 0.3, 0.5};
+  settings.selfCollision = {selfCollision, SelfContactMethod::particles, 0.045, 0.3, 0.5};
   return settings;
 }
 

@@ -133,6 +133,7 @@ sim::ColliderSettings readCollider(ObjectReader& reader, const std::string& scen
 sim::SelfCollisionSettings readSelfCollision(ObjectReader& reader) {
   sim::SelfCollisionSettings s;
   s.enabled = reader.boolean("enabled", true);
+  s.method = *sim::parseSelfContactMethod(reader.choice("method", "triangles", {"triangles", "particles"}));
   s.distance = reader.number("distance", s.distance, {1.0e-4, 1.0, false, "m"});
   s.friction = reader.number("friction", s.friction, {0.0, 1.0, false, "share of relative velocity removed"});
   s.maxTravel = reader.number("maxTravel", s.maxTravel, {0.01, 10.0, false, "distances per substep"});

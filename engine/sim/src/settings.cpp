@@ -37,6 +37,18 @@ std::optional<Integrator> parseIntegrator(std::string_view text) {
   return lookupValue<Integrator>(kIntegratorNames, text);
 }
 
+namespace {
+constexpr std::array<std::pair<SelfContactMethod, std::string_view>, 2> kSelfContactNames{{
+    {SelfContactMethod::triangles, "triangles"},
+    {SelfContactMethod::particles, "particles"},
+}};
+}  // namespace
+
+std::string_view name(SelfContactMethod method) { return lookupName(kSelfContactNames, method); }
+std::optional<SelfContactMethod> parseSelfContactMethod(std::string_view text) {
+  return lookupValue<SelfContactMethod>(kSelfContactNames, text);
+}
+
 std::string_view name(Stage stage) {
   switch (stage) {
     case Stage::windPressure: return "wind pressure";
@@ -47,6 +59,7 @@ std::string_view name(Stage stage) {
     case Stage::collide: return "collide";
     case Stage::friction: return "friction";
     case Stage::selfCollide: return "self-collide";
+    case Stage::selfContact: return "self-contact";
     case Stage::collideForces: return "collide (forces)";
     case Stage::explicitEuler: return "explicit euler";
     case Stage::symplecticEuler: return "symplectic euler";

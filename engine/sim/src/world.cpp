@@ -16,6 +16,7 @@
 #include "force_model.hpp"
 #include "lines.hpp"
 #include "position_model.hpp"
+#include "self_contact.hpp"
 #include "tethers.hpp"
 #include "topology.hpp"
 #include "workers.hpp"
@@ -240,7 +241,11 @@ void World::buildPipeline() {
     }
   }
   const bool anyColliders = !colliders_.empty();
-  const bool selfCollision = settings_.selfCollision.enabled && model == Model::position;
+  const bool selfContact = settings_.selfCollision.enabled && model == Model::position && anyTriangles &&
+                           settings_.selfCollision.method == SelfContactMethod::triangles;
+  const bool selfCollision = settings_.selfCollision.enabled && model == Model::position &&
+                             settings_.selfCollision.method == SelfContactMethod::particles;
+  selfContactHolds_ = selfContact;
   bool anyHeld = false;
   for (const Finger& finger : fingers_) anyHeld = anyHeld || !finger.grips.empty();
 
@@ -263,7 +268,11 @@ void World::buildPipeline() {
     if (selfCollision) add(Stage::selfCollide, true);
     if (anyColliders) add(Stage::collide, true);
     if (anyProjected && settings_.solver.iterations > 0) add(Stage::projectConstraints, true);
-    if (anyColliders) add(Stage::friction, true);
+    // Self-contact after everything else that moves positions, so that its fail-safe has the last
+    // word: nothing after it in a substep moves a particle (constraint damping changes velocities).
+    // It applies the colliders' friction itself, between its sweeps and its fail-safe.
+    if (anyColliders && !selfContact) add(Stage::friction, true);
+    if (selfContact) add(Stage::selfContact, true);
     if (selfCollision) add(Stage::clampTravel, true);
     if (anyDamped) add(Stage::dampConstraints, true);
   } else {
@@ -284,6 +293,7 @@ void World::buildPipeline() {
         case Stage::projectConstraints:
         case Stage::collide:
         case Stage::friction:
+        case Stage::selfContact:
         case Stage::guard:
         case Stage::tear: break;
         default: return false;
@@ -386,6 +396,7 @@ MemoryUse World::memoryUse() const {
   const SelfCollisionScratch& h = selfCollisionScratch_;
   m.solver += bytes(h.owner) + bytes(h.cell) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
   for (const auto& pairs : h.pairs) m.solver += bytes(pairs);
+  if (selfContact_) m.solver += selfContact_->bytes();
   return m;
 }
 
@@ -402,6 +413,8 @@ std::int64_t World::extraLineSteps() const {
   for (const SolverScratch& s : scratch_) n += s.extraLineSteps;
   return n;
 }
+
+SelfContactStats World::selfContactStats() const { return selfContact_ ? selfContact_->stats() : SelfContactStats{}; }
 
 World::~World() = default;
 World::World(World&&) noexcept = default;
@@ -470,6 +483,16 @@ void World::runStage(Stage stage) {
     contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_, *workers_);
     return;
   }
+  if (stage == Stage::selfContact) {
+    if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
+    selfContact_->solve(cloths_, scratch_, settings_.selfCollision, topologyVersion_,
+                        settings_.solver.substeps - substep_, *workers_);
+    if (!colliders_.empty()) {
+      for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, h, scratch_[c]);
+    }
+    selfContact_->finish(cloths_, settings_.selfCollision, *workers_);
+    return;
+  }
   if (stage == Stage::fingers) {
     moveFingers(h);
     return;
@@ -503,7 +526,8 @@ void World::runStage(Stage stage) {
       case Stage::rk4: force::step(settings_.solver.integrator, cloth, settings_, h, scratch); break;
       case Stage::fingers:      // world-wide, above
       case Stage::selfCollide:  // world-wide, above
-      case Stage::guard:        // once per step, in step()
+      case Stage::selfContact:
+      case Stage::guard:  // once per step, in step()
       case Stage::tear: break;
     }
   }
@@ -791,9 +815,23 @@ void World::moveFingers(Real h) {
     const Vec3 start = f.position + path * from;
     const Vec3 travel = path * (to - from);
     for (const FingerGrip& grip : f.grips) {
+      ParticleState& s = cloths_[static_cast<std::size_t>(grip.cloth)].state;
+      if (selfContactHolds_) {
+        // Self-contact may have held the particle back where the finger would have driven it through
+        // cloth (its fail-safe moves a held particle with the rest of an impact zone): it goes on from
+        // where it is, one substep's travel behind where the finger will be at the end of this one,
+        // and the integrator (inverse mass 0) carries it there.
+        // It catches up at most half the contact distance a substep faster than the finger moves, so
+        // that it is not flung when it comes free (nor when the finger lets go just then).
+        const Vec3 x = s.position[grip.particle];
+        Vec3 move = start + travel + grip.offset - x;
+        const Real length = glm::length(move), most = glm::length(travel) + 0.5 * settings_.selfCollision.distance;
+        if (length > most) move *= most / length;
+        s.previousPosition[grip.particle] = x - move;
+        continue;
+      }
       // Set where the finger is at the start of the substep, and one substep's travel behind: the
       // integrator then carries the particle to where the finger is at its end (inverse mass 0).
-      ParticleState& s = cloths_[static_cast<std::size_t>(grip.cloth)].state;
       s.position[grip.particle] = start + grip.offset;
       s.previousPosition[grip.particle] = start + grip.offset - travel;
       if (!s.velocity.empty()) s.velocity[grip.particle] = travel / h;

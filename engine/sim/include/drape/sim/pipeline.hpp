@@ -23,6 +23,7 @@ enum class Stage : std::uint8_t {
   collide,             // find contact planes along each particle's motion; project onto them
   friction,            // Coulomb friction against colliders, after the sweeps
   selfCollide,         // push apart particles of a cloth that come too close
+  selfContact,         // keep triangles apart and never through each other (self_contact.hpp)
   // force model, once per substep: forces are evaluated inside the integrator
   explicitEuler,
   symplecticEuler,

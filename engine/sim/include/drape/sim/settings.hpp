@@ -121,13 +121,30 @@ struct ClothSettings {
   const KindMaterial& material(ConstraintKind kind) const { return materials[static_cast<std::size_t>(kind)]; }
 };
 
-// Particles keeping apart, within a cloth and between cloths (Ten Minute Physics 15; Teschner et
-// al. 2003 hashing).
+// Cloth keeping out of cloth, within a cloth and between cloths.
+enum class SelfContactMethod : std::uint8_t {
+  // Triangles: no surface within `distance` of another, and no step makes two triangles pass through
+  // each other (self_contact.hpp: vertex-triangle and edge-edge contacts, and an exact fail-safe).
+  triangles,
+  // Particles: no particle within `distance` of another (Ten Minute Physics 15; Teschner et al. 2003
+  // hashing), and a cap on each particle's travel so it cannot cross a layer in one substep.
+  particles,
+};
+
+std::string_view name(SelfContactMethod method);
+std::optional<SelfContactMethod> parseSelfContactMethod(std::string_view text);
+
 struct SelfCollisionSettings {
   bool enabled = false;
-  Real distance = 0.01;  // m, closest two particles may come (unless closer at rest in one cloth)
-  Real friction = 0.2;   // 0..1, share of their relative velocity removed on contact
-  Real maxTravel = 0.5;  // fraction of `distance` a particle may move per substep (no crossing)
+  SelfContactMethod method = SelfContactMethod::triangles;
+  // m: triangles: the gap kept between two surfaces (the cloth's thickness); particles: the closest
+  // two particles may come. Either way, parts of one cloth closer than that at rest keep their rest
+  // distance.
+  Real distance = 0.01;
+  // 0..1: triangles: Coulomb's coefficient between layers; particles: the share of a touching pair's
+  // relative velocity removed.
+  Real friction = 0.2;
+  Real maxTravel = 0.5;  // particles only: fraction of `distance` a particle may move per substep (no crossing)
 };
 
 // Tearing (the seed's node splitting): a stretch constraint longer than `threshold` times its rest

@@ -59,7 +59,19 @@ struct Divergence {
 
 enum class StepStatus : std::uint8_t { ok, diverged };
 
+// What self-contact between triangles (selfCollision.method triangles) did.
+struct SelfContactStats {
+  std::int64_t pairs = 0;      // last substep: vertex-triangle and edge-edge pairs the broad phase found
+  std::int64_t pushed = 0;     // last substep: of them, pushed apart
+  std::int64_t tested = 0;     // since the world was made: pairs not proven apart, tested exactly
+  std::int64_t zoned = 0;      // since made: particles the fail-safe moved as one body with others (a zone)
+  std::int64_t fallbacks = 0;  // since made: substeps whose zones went back to where they began
+};
+
 class Workers;
+namespace contact {
+class SelfContact;
+}
 
 // Bytes a world keeps (every array's capacity), by what they are for.
 struct MemoryUse {
@@ -120,6 +132,7 @@ class World {
   double substepDt() const { return settings_.solver.dt / settings_.solver.substeps; }
   const std::optional<Divergence>& divergence() const { return divergence_; }
   const Profile& profile() const { return profile_; }
+  SelfContactStats selfContactStats() const;
   bool hasStage(Stage stage) const;
   // Changes whenever the set of cloths or any cloth's triangles or constraints change (tearing,
   // cutting, spawning), and differs between worlds: a renderer re-uploads index buffers only then.
@@ -215,6 +228,10 @@ class World {
   std::vector<SolverScratch> scratch_;  // per cloth
   std::vector<Collider> colliders_;
   SelfCollisionScratch selfCollisionScratch_;
+  std::unique_ptr<contact::SelfContact> selfContact_;  // made at the first substep that needs it
+  // Self-contact is on: a held particle may lag its finger where the finger would drive it through
+  // cloth (moveFingers).
+  bool selfContactHolds_ = false;
   int substep_ = 0;  // within the current step
   // Where the guard finds the positions before the current step (World::step).
   enum class GuardCopy : std::uint8_t {

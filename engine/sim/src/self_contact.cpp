@@ -1,0 +1,729 @@
+#include "self_contact.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "exact_triangles.hpp"
+
+namespace drape::sim::contact {
+
+namespace {
+
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+// Sweeps of the contacts a substep: each pair is pushed out in the first; the rest settle pairs
+// that push each other (a particle between two layers).
+constexpr int kSweeps = 4;
+// Room left for rounding where the fail-safe proves two primitives apart, m: far above the error of
+// the distances (1e-12 m), above the exact test's grid (6e-8 m).
+constexpr Real kProofMargin = 1e-6;
+// Two points closer than this at x0 give no direction to keep apart along.
+constexpr Real kCoincident = 1e-12;
+
+// `inverse`: 1 / the cell's size.
+glm::i64vec3 cellOf(Vec3 x, Real inverse) {
+  // Positions are finite and within 1e6 m (the guard): the cell always fits.
+  const Vec3 c = glm::clamp(x, Vec3(-2.0e6), Vec3(2.0e6)) * inverse;
+  return {static_cast<std::int64_t>(std::floor(c.x)), static_cast<std::int64_t>(std::floor(c.y)),
+          static_cast<std::int64_t>(std::floor(c.z))};
+}
+
+std::size_t hashOf(glm::i64vec3 cell, std::size_t mask) {
+  const glm::u64vec3 u(cell);  // wrapping
+  const std::uint64_t h = (u.x * 92837111u) ^ (u.y * 689287499u) ^ (u.z * 283923481u);
+  return static_cast<std::size_t>((h ^ (h >> 29)) & mask);
+}
+
+std::uint64_t cellsIn(glm::i64vec3 lo, glm::i64vec3 hi) {
+  const glm::u64vec3 span(hi - lo + glm::i64vec3(1));
+  return span.x * span.y * span.z;
+}
+
+// Closest point of triangle abc to p, as barycentric weights of a, b, c (by the triangle's Voronoi
+// regions: a corner, an edge, or the inside).
+Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const Real d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};
+  const Vec3 bp = p - b;
+  const Real d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return {0.0, 1.0, 0.0};
+  const Real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0) {
+    const Real t = d1 / (d1 - d3);
+    return {1.0 - t, t, 0.0};
+  }
+  const Vec3 cp = p - c;
+  const Real d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return {0.0, 0.0, 1.0};
+  const Real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0) {
+    const Real t = d2 / (d2 - d6);
+    return {1.0 - t, 0.0, t};
+  }
+  const Real va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 && (d4 - d3) + (d5 - d6) > 0.0) {
+    const Real t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0.0, 1.0 - t, t};
+  }
+  const Real sum = va + vb + vc;
+  if (!(sum > 0.0)) {
+    // No area: the nearest corner will do.
+    const Real da = glm::dot(ap, ap), db = glm::dot(bp, bp), dc = glm::dot(cp, cp);
+    return da <= db && da <= dc ? Vec3{1.0, 0.0, 0.0} : db <= dc ? Vec3{0.0, 1.0, 0.0} : Vec3{0.0, 0.0, 1.0};
+  }
+  const Real v = vb / sum, w = vc / sum;
+  return {1.0 - v - w, v, w};
+}
+
+// Closest points of segments p1q1 and p2q2: p1 + s (q1 - p1) and p2 + t (q2 - p2).
+std::pair<Real, Real> closestOnSegments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2) {
+  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+  const Real a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+  constexpr Real tiny = 1e-30;
+  if (a <= tiny && e <= tiny) return {0.0, 0.0};
+  if (a <= tiny) return {0.0, std::clamp(f / e, 0.0, 1.0)};
+  const Real c = glm::dot(d1, r);
+  if (e <= tiny) return {std::clamp(-c / a, 0.0, 1.0), 0.0};
+  const Real b = glm::dot(d1, d2);
+  const Real denominator = a * e - b * b;
+  Real s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+  Real t = (b * s + f) / e;
+  if (t < 0.0) {
+    t = 0.0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (t > 1.0) {
+    t = 1.0;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+  return {s, t};
+}
+
+struct Weights {
+  Real c[4];
+};
+
+Weights vertexTriangleWeights(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 bary = closestOnTriangle(p, a, b, c);
+  return {{1.0, -bary.x, -bary.y, -bary.z}};
+}
+
+Weights edgeEdgeWeights(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1) {
+  const auto [s, t] = closestOnSegments(a0, a1, b0, b1);
+  return {{1.0 - s, s, -(1.0 - t), -t}};
+}
+
+// sum_k c_k x_k: the first point minus the second.
+Vec3 between(const Weights& w, const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
+  return p0 * w.c[0] + p1 * w.c[1] + p2 * w.c[2] + p3 * w.c[3];
+}
+
+struct GridBuild {
+  const Vec3* lower;
+  const Vec3* upper;
+  std::size_t count;
+};
+
+// Every primitive into each cell its box covers; false (nothing built) if that would be more than
+// `budget` entries.
+// A cell's coordinates in one word: 21 bits each, enough to tell apart the cells of one bucket (cells
+// 2^21 apart along an axis share a word, and are told apart by their boxes: Entry's use below).
+std::uint64_t packed(glm::i64vec3 c) {
+  const glm::u64vec3 u(c);
+  constexpr std::uint64_t mask = (1u << 21) - 1;
+  return (u.x & mask) | ((u.y & mask) << 21) | ((u.z & mask) << 42);
+}
+
+// A box in single precision, grown to hold the double one.
+glm::vec3 below(const Vec3& x) {
+  return {std::nextafter(static_cast<float>(x.x), -INFINITY), std::nextafter(static_cast<float>(x.y), -INFINITY),
+          std::nextafter(static_cast<float>(x.z), -INFINITY)};
+}
+glm::vec3 above(const Vec3& x) {
+  return {std::nextafter(static_cast<float>(x.x), INFINITY), std::nextafter(static_cast<float>(x.y), INFINITY),
+          std::nextafter(static_cast<float>(x.z), INFINITY)};
+}
+
+template <class Entry>
+bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, const GridBuild& build, Real inverse,
+              std::uint64_t budget) {
+  std::uint64_t total = 0;
+  // Cells from the boxes as the entries keep them (single precision, rounded outwards): a pair's
+  // overlap then lies in cells both cover (query below).
+  const auto cellsOf = [&](std::size_t i) {
+    return std::pair{cellOf(Vec3(below(build.lower[i])), inverse), cellOf(Vec3(above(build.upper[i])), inverse)};
+  };
+  for (std::size_t i = 0; i < build.count; ++i) {
+    const auto [lo, hi] = cellsOf(i);
+    total += cellsIn(lo, hi);
+    if (total > budget) return false;
+  }
+  const std::size_t table = std::bit_ceil(static_cast<std::size_t>(2 * total + 1));
+  const std::size_t mask = table - 1;
+  start.assign(table + 1, 0);
+  const auto each = [&](std::size_t i, auto&& f) {
+    const auto [lo, hi] = cellsOf(i);
+    for (std::int64_t z = lo.z; z <= hi.z; ++z) {
+      for (std::int64_t y = lo.y; y <= hi.y; ++y) {
+        for (std::int64_t x = lo.x; x <= hi.x; ++x) f(glm::i64vec3(x, y, z));
+      }
+    }
+  };
+  for (std::size_t i = 0; i < build.count; ++i) each(i, [&](glm::i64vec3 c) { ++start[hashOf(c, mask) + 1]; });
+  for (std::size_t k = 0; k < table; ++k) start[k + 1] += start[k];
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  entries.resize(static_cast<std::size_t>(total));
+  for (std::size_t i = 0; i < build.count; ++i) {
+    const glm::vec3 lo = below(build.lower[i]), hi = above(build.upper[i]);
+    each(i, [&](glm::i64vec3 c) {
+      const std::uint32_t k = fill[hashOf(c, mask)]++;
+      entries[k] = {packed(c), static_cast<std::uint32_t>(i), lo, hi};
+    });
+  }
+  return true;
+}
+
+}  // namespace
+
+std::size_t SelfContact::bytes() const {
+  const auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  std::size_t total = b(clothOf_) + b(rest_) + b(triangles_) + b(edges_) + b(edgeTriangles_) + b(vertexStart_) +
+                      b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) + b(upper_) + b(pairs_) +
+                      b(active_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_);
+  for (const Grid* g : {&triangleGrid_, &edgeGrid_}) total += b(g->start) + b(g->entries);
+  for (const std::vector<Pair>& found : found_) total += b(found);
+  return total;
+}
+
+void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
+  clothOf_.clear();
+  rest_.clear();
+  triangles_.clear();
+  for (std::size_t c = 0; c < cloths.size(); ++c) {
+    const auto base = static_cast<std::uint32_t>(clothOf_.size());
+    const Cloth& cloth = cloths[c];
+    for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+      clothOf_.push_back(static_cast<std::uint32_t>(c));
+      rest_.push_back(cloth.rest.restPosition(i));
+    }
+    for (const glm::uvec3& t : cloth.rest.triangles) triangles_.push_back(t + base);
+  }
+  const std::size_t n = clothOf_.size();
+  // Edges: each once, with the (one or two) triangles on it.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> sides;
+  sides.reserve(triangles_.size() * 3);
+  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = triangles_[t][k], b = triangles_[t][(k + 1) % 3];
+      sides.push_back({(static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b), t});
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  edges_.clear();
+  edgeTriangles_.clear();
+  for (std::size_t i = 0; i < sides.size();) {
+    std::size_t j = i;
+    while (j < sides.size() && sides[j].first == sides[i].first) ++j;
+    edges_.push_back({static_cast<std::uint32_t>(sides[i].first >> 32), static_cast<std::uint32_t>(sides[i].first)});
+    edgeTriangles_.push_back(sides[i].second);
+    edgeTriangles_.push_back(j - i > 1 ? sides[i + 1].second : kNone);
+    i = j;
+  }
+  vertexStart_.assign(n + 1, 0);
+  for (const glm::uvec3& t : triangles_) {
+    for (int k = 0; k < 3; ++k) ++vertexStart_[t[k] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) vertexStart_[i + 1] += vertexStart_[i];
+  vertexTriangles_.resize(vertexStart_[n]);
+  std::vector<std::uint32_t> fill(vertexStart_.begin(), vertexStart_.end() - 1);
+  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+    for (int k = 0; k < 3; ++k) vertexTriangles_[fill[triangles_[t][k]]++] = t;
+  }
+  meshParticles_ = n;
+}
+
+void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>& scratch) {
+  const std::size_t n = clothOf_.size();
+  x0_.resize(n);
+  x_.resize(n);
+  w_.resize(n);
+  planes_.clear();
+  std::size_t k = 0;
+  for (std::size_t c = 0; c < cloths.size(); ++c) {
+    const ParticleState& s = cloths[c].state;
+    const SolverScratch& contacts = scratch[c];
+    const bool planes = contacts.contactCollider.size() == s.position.size();
+    for (std::size_t i = 0; i < s.position.size(); ++i, ++k) {
+      x0_[k] = s.previousPosition[i];  // where the substep began: the integration left it there
+      x_[k] = s.position[i];
+      w_[k] = s.inverseMass[i];
+      if (planes && contacts.contactCollider[i] >= 0) {
+        planes_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(i),
+                           contacts.contactNormal[i], contacts.contactOffset[i]});
+      }
+    }
+  }
+}
+
+void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
+  const std::size_t n = x_.size(), nt = triangles_.size(), ne = edges_.size();
+  // Boxes: each particle's motion, from x0 on for `ahead` times its motion in this substep (the
+  // substeps left in the step: the pairs then serve for all of them while the particles keep
+  // within), grown by `distance`, so that two boxes overlap wherever two primitives may come within
+  // twice that. The solve may push a particle up to `distance` beyond, before the pairs must be found
+  // again (SelfContact::withinBoxes).
+  const Real grow = distance;
+  lower_.resize(n + nt + ne);
+  upper_.resize(n + nt + ne);
+  Real extent = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 to = x0_[i] + (x_[i] - x0_[i]) * ahead;
+    lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
+    upper_[i] = glm::max(glm::max(x0_[i], x_[i]), to) + grow;
+  }
+  for (std::size_t t = 0; t < nt; ++t) {
+    const glm::uvec3 v = triangles_[t];
+    lower_[n + t] = glm::min(glm::min(lower_[v[0]], lower_[v[1]]), lower_[v[2]]);
+    upper_[n + t] = glm::max(glm::max(upper_[v[0]], upper_[v[1]]), upper_[v[2]]);
+    // The cells' size comes from the triangles as they are (plus the growth), not as they sweep:
+    // a patch a finger flings far covers many cells instead of making every cell hold everything.
+    const Vec3 size =
+        glm::max(glm::max(x_[v[0]], x_[v[1]]), x_[v[2]]) - glm::min(glm::min(x_[v[0]], x_[v[1]]), x_[v[2]]);
+    extent += std::max({size.x, size.y, size.z}) + 2.0 * grow;
+  }
+  for (std::size_t e = 0; e < ne; ++e) {
+    const glm::uvec2 v = edges_[e];
+    lower_[n + nt + e] = glm::min(lower_[v[0]], lower_[v[1]]);
+    upper_[n + nt + e] = glm::max(upper_[v[0]], upper_[v[1]]);
+  }
+  // Cells about a triangle's box wide; wider while a few huge boxes (a particle flung far) would
+  // fill the grid.
+  cellSize_ = nt > 0 ? std::max(1.5 * extent / static_cast<Real>(nt), 1e-6) : 1.0;
+  const std::uint64_t budget = 16 * static_cast<std::uint64_t>(nt + ne) + (1u << 20);
+  while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, {lower_.data() + n, upper_.data() + n, nt},
+                   1.0 / cellSize_, budget) ||
+         !fillGrid(edgeGrid_.start, edgeGrid_.entries, {lower_.data() + n + nt, upper_.data() + n + nt, ne},
+                   1.0 / cellSize_, budget)) {
+    cellSize_ *= 2.0;
+  }
+
+  found_.resize(static_cast<std::size_t>(workers.threads()));
+  for (std::vector<Pair>& found : found_) found.clear();
+  // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap.
+  // `accept(other)` first: a cheap test of the pair by its indices.
+  const auto query = [&](const Grid& grid, std::size_t self, auto&& accept, auto&& emit) {
+    const glm::vec3 lo = below(lower_[self]), hi = above(upper_[self]);
+    const Real inverse = 1.0 / cellSize_;
+    const glm::i64vec3 from = cellOf(Vec3(lo), inverse), to = cellOf(Vec3(hi), inverse);
+    const bool oneCell = from == to;  // then every overlap lies in it
+    const std::size_t mask = grid.start.size() - 2;
+    for (std::int64_t z = from.z; z <= to.z; ++z) {
+      for (std::int64_t y = from.y; y <= to.y; ++y) {
+        for (std::int64_t x = from.x; x <= to.x; ++x) {
+          const glm::i64vec3 cell(x, y, z);
+          const std::uint64_t key = packed(cell);
+          const std::size_t bucket = hashOf(cell, mask);
+          for (std::uint32_t k = grid.start[bucket]; k < grid.start[bucket + 1]; ++k) {
+            const Entry& e = grid.entries[k];
+            if (e.cell != key || !accept(e.index)) continue;
+            if (!(lo.x <= e.upper.x && e.lower.x <= hi.x && lo.y <= e.upper.y && e.lower.y <= hi.y &&
+                  lo.z <= e.upper.z && e.lower.z <= hi.z)) {
+              continue;
+            }
+            // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap.
+            if (!oneCell && cellOf(Vec3(glm::max(lo, e.lower)), inverse) != cell) continue;
+            emit(e.index);
+          }
+        }
+      }
+    }
+  };
+  // Vertex-triangle pairs, each thread its run of particles.
+  workers.run(
+      n,
+      [&](std::size_t begin, std::size_t end, int thread) {
+        std::vector<Pair>& found = found_[static_cast<std::size_t>(thread)];
+        for (std::size_t v = begin; v < end; ++v) {
+          const auto notCorner = [&](std::uint32_t t) {
+            const glm::uvec3 c = triangles_[t];
+            return c[0] != v && c[1] != v && c[2] != v;
+          };
+          query(triangleGrid_, v, notCorner, [&](std::uint32_t t) {
+            const glm::uvec3 c = triangles_[t];
+            Pair pair{};
+            pair.v[0] = static_cast<std::uint32_t>(v);
+            pair.v[1] = c[0];
+            pair.v[2] = c[1];
+            pair.v[3] = c[2];
+            pair.first = static_cast<std::uint32_t>(v);
+            pair.second = t;
+            pair.edges = false;
+            found.push_back(pair);
+          });
+        }
+      },
+      256);
+  pairs_.clear();
+  for (const std::vector<Pair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
+  for (std::vector<Pair>& found : found_) found.clear();
+  // Edge-edge pairs, each thread its run of edges; each pair from its lower edge.
+  workers.run(
+      ne,
+      [&](std::size_t begin, std::size_t end, int thread) {
+        std::vector<Pair>& found = found_[static_cast<std::size_t>(thread)];
+        for (std::size_t e = begin; e < end; ++e) {
+          const glm::uvec2 a = edges_[e];
+          const auto apart = [&](std::uint32_t f) {
+            if (f <= e) return false;
+            const glm::uvec2 b = edges_[f];
+            return a[0] != b[0] && a[0] != b[1] && a[1] != b[0] && a[1] != b[1];
+          };
+          query(edgeGrid_, n + nt + e, apart, [&](std::uint32_t f) {
+            const glm::uvec2 b = edges_[f];
+            Pair pair{};
+            pair.v[0] = a[0];
+            pair.v[1] = a[1];
+            pair.v[2] = b[0];
+            pair.v[3] = b[1];
+            pair.first = static_cast<std::uint32_t>(e);
+            pair.second = f;
+            pair.edges = true;
+            found.push_back(pair);
+          });
+        }
+      },
+      256);
+  for (const std::vector<Pair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
+}
+
+void SelfContact::measurePairs(Real distance, Workers& workers) {
+  // Each pair's closest points at x0, the direction between them, and how far apart they keep.
+  workers.run(
+      pairs_.size(),
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t i = begin; i < end; ++i) {
+          Pair& pair = pairs_[i];
+          const std::uint32_t* v = pair.v;
+          const bool same = clothOf_[v[0]] == clothOf_[v[2]];
+          Weights weights, restWeights{};
+          if (pair.edges) {
+            weights = edgeEdgeWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
+            if (same) restWeights = edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
+          } else {
+            weights = vertexTriangleWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
+            if (same) restWeights = vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
+          }
+          for (int k = 0; k < 4; ++k) pair.c[k] = weights.c[k];
+          const Vec3 gap = between(weights, x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
+          pair.gap0 = glm::length(gap);
+          pair.normal = pair.gap0 > kCoincident ? gap / pair.gap0 : Vec3{0.0};
+          pair.target = distance;
+          if (same) {
+            // Parts of one cloth closer than `distance` at rest keep their rest distance.
+            pair.target = std::min(
+                distance, glm::length(between(restWeights, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])));
+          }
+          pair.push = 0.0;
+        }
+      },
+      1024);
+}
+
+void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch) {
+  const auto gapNow = [&](const Pair& p) {
+    Real g = -p.target;
+    for (int k = 0; k < 4; ++k) g += p.c[k] * glm::dot(p.normal, x_[p.v[k]]);
+    return g;
+  };
+  // How far each unit the two points must part moves the particles: 1 / sum_k c_k^2 w_k, so that
+  // the masses share the move; less where that would move one particle more than the points part
+  // (a held vertex against a triangle whose only free corner has a small weight there: the pair is
+  // then left to the fail-safe rather than the corner flung).
+  const auto reach = [&](const Pair& p) {
+    Real denominator = 0.0, most = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      denominator += p.c[k] * p.c[k] * w_[p.v[k]];
+      most = std::max(most, std::abs(p.c[k]) * w_[p.v[k]]);
+    }
+    if (!(denominator > 0.0)) return 0.0;
+    return std::min(1.0 / denominator, 1.0 / most);
+  };
+  // Whether the two points still face each other across the normal: their offset along the
+  // surface within the size of the primitives (else one slid off the other's side, or a finger
+  // flung it far, and the half-space of x0 says nothing about them).
+  const auto facing = [&](const Pair& p) {
+    Vec3 offset{0.0};
+    for (int k = 0; k < 4; ++k) offset += x_[p.v[k]] * p.c[k];
+    const Vec3 along = offset - p.normal * glm::dot(p.normal, offset);
+    Real size = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        const Vec3 d = x_[p.v[i]] - x_[p.v[j]];
+        const bool within = p.edges ? (j < 2 || i >= 2) : i >= 1;  // two corners of one primitive
+        if (within) size = std::max(size, glm::dot(d, d));
+      }
+    }
+    return glm::dot(along, along) <= size + p.target * p.target;
+  };
+  // The pairs a sweep can push: within one more `distance` of their target now.
+  active_.clear();
+  for (std::uint32_t i = 0; i < pairs_.size(); ++i) {
+    const Pair& p = pairs_[i];
+    if (p.gap0 > kCoincident && gapNow(p) < distance) active_.push_back(i);
+  }
+  const std::vector<std::uint32_t>& active = active_;
+  for (int sweep = 0; sweep < kSweeps; ++sweep) {
+    for (const std::uint32_t i : active) {
+      Pair& p = pairs_[i];
+      const Real g = gapNow(p);
+      if (g >= 0.0 || !facing(p)) continue;
+      const Real lambda = -g * reach(p);
+      if (!(lambda > 0.0)) continue;
+      for (int k = 0; k < 4; ++k) x_[p.v[k]] += p.normal * (p.c[k] * w_[p.v[k]] * lambda);
+      p.push -= g;
+    }
+    for (const Plane& plane : planes_) {
+      const Real gap = glm::dot(plane.normal, x_[plane.particle]) - plane.offset;
+      if (gap < 0.0) {
+        x_[plane.particle] -= plane.normal * gap;
+        scratch[plane.cloth].contactDepth[plane.index] -= gap;
+      }
+    }
+  }
+  std::int64_t pushed = 0;
+  for (const std::uint32_t i : active) {
+    Pair& p = pairs_[i];
+    if (p.push <= 0.0) continue;
+    ++pushed;
+    if (friction <= 0.0) continue;
+    const Real scale = reach(p);
+    if (!(scale > 0.0)) continue;
+    Vec3 relative{0.0};
+    for (int k = 0; k < 4; ++k) relative += (x_[p.v[k]] - x0_[p.v[k]]) * p.c[k];
+    const Vec3 tangential = relative - p.normal * glm::dot(p.normal, relative);
+    const Real length = glm::length(tangential);
+    if (!(length > 0.0)) continue;
+    const Vec3 change = tangential * (-std::min(friction * p.push / length, 1.0) * scale);
+    for (int k = 0; k < 4; ++k) x_[p.v[k]] += change * (p.c[k] * w_[p.v[k]]);
+  }
+  stats_.pushed = pushed;
+}
+
+bool SelfContact::withinBoxes(Real margin) const {
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    const Vec3 lo = lower_[i] + margin, hi = upper_[i] - margin;
+    for (const Vec3& x : {x0_[i], x_[i]}) {
+      if (glm::any(glm::lessThan(x, lo)) || glm::any(glm::greaterThan(x, hi))) return false;
+    }
+  }
+  return true;
+}
+
+void SelfContact::failSafe(Real distance, Workers& workers) {
+  // The boxes must hold every particle's whole motion: where the solve took one beyond them, the
+  // pairs are found again for the motion as it now is.
+  if (!withinBoxes(0.0)) {
+    findPairs(distance, 1.0, workers);
+    measurePairs(distance, workers);
+  }
+  const std::size_t n = x_.size();
+  triangleMoved_.assign(triangles_.size(), 0);
+  if (inZone_.size() != n) inZone_.assign(n, 0);
+  zone_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) zone_[i] = i;
+  const auto root = [&](std::uint32_t i) {
+    while (zone_[i] != i) i = zone_[i] = zone_[zone_[i]];
+    return i;
+  };
+  const std::vector<Vec3> solved = x_;  // each particle's motion as the contacts left it
+  const auto triangleAt = [&](const std::vector<Vec3>& x, std::uint32_t t) {
+    const glm::uvec3 c = triangles_[t];
+    return exact::makeTriangle(x[c[0]], x[c[1]], x[c[2]], {c[0], c[1], c[2]});
+  };
+  // Whether triangles s and t intersect now and did not at x0.
+  // Particles of one cloth at one grid point are one corner, as the counter has them
+  // (countIntersections): the copies a tear makes, before the seam opens.
+  const auto through = [&](std::optional<exact::Triangle> a, std::optional<exact::Triangle> b) {
+    if (!a || !b) return false;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (a->particle[i] != b->particle[j] && a->p[i] == b->p[j] &&
+            clothOf_[a->particle[i]] == clothOf_[b->particle[j]]) {
+          b->particle[j] = a->particle[i];
+        }
+      }
+    }
+    return exact::intersect(*a, *b);
+  };
+  const auto newlyThrough = [&](std::uint32_t s, std::uint32_t t) {
+    return through(triangleAt(x_, s), triangleAt(x_, t)) && !through(triangleAt(x0_, s), triangleAt(x0_, t));
+  };
+  // The triangles the fail-safe tests for a pair: around its vertex against its triangle, or those
+  // on its first edge against those on its second.
+  const auto eachTest = [&](const Pair& p, auto&& f) {
+    if (p.edges) {
+      for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) {
+          const std::uint32_t s = edgeTriangles_[2 * p.first + i], t = edgeTriangles_[2 * p.second + j];
+          if (s != kNone && t != kNone) f(s, t);
+        }
+      }
+    } else {
+      for (std::uint32_t k = vertexStart_[p.first]; k < vertexStart_[p.first + 1]; ++k)
+        f(vertexTriangles_[k], p.second);
+    }
+  };
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> passing;
+  std::vector<std::uint32_t> members;  // particles in a zone of more than one
+  std::vector<Vec3> sum;               // per zone root: mass-weighted motion
+  std::vector<Real> weight;
+  // Every round but the last joins two zones or more: at most one round a particle.
+  for (std::uint32_t round = 1;; ++round) {
+    passing.clear();
+    for (const Pair& p : pairs_) {
+      if (round > 1) {
+        // After the first round, only pairs whose tests a zone's move changed.
+        bool moved = false;
+        eachTest(p, [&](std::uint32_t s, std::uint32_t t) { moved = moved || triangleMoved_[s] || triangleMoved_[t]; });
+        if (!moved) continue;
+      }
+      // The largest relative motion of a corner of one against a corner of the other.
+      Real m = 0.0;
+      const int split = p.edges ? 2 : 1;
+      for (int i = 0; i < split; ++i) {
+        for (int j = split; j < 4; ++j) {
+          const Vec3 d = (x_[p.v[i]] - x0_[p.v[i]]) - (x_[p.v[j]] - x0_[p.v[j]]);
+          m = std::max(m, glm::dot(d, d));
+        }
+      }
+      if (p.gap0 > std::sqrt(m) + kProofMargin) continue;  // proven apart all the way
+      ++stats_.tested;
+      eachTest(p, [&](std::uint32_t s, std::uint32_t t) {
+        if (newlyThrough(s, t)) passing.push_back({s, t});
+      });
+    }
+    if (passing.empty()) break;
+    // A pair's free corners join one zone, which moves as one body from x0 by the mass-weighted mean
+    // of its particles' motions: the zone is then as it was at x0, where none of its triangles
+    // intersect, and its momentum is kept. Held and pinned corners are obstacles that move as their
+    // fingers do, until a pair goes on through one whose free corners already move as one (or has
+    // none): then they join the zone too, and it moves as they do on average (they count as
+    // infinitely heavy), the finger's grip slipping for the substep.
+    bool joined = false;
+    for (const auto& [s, t] : passing) {
+      std::uint32_t corners[6], zoneOfFree = kNone;
+      bool oneZone = true, anyFree = false;
+      for (int k = 0; k < 6; ++k) {
+        corners[k] = triangles_[k < 3 ? s : t][k % 3];
+        if (w_[corners[k]] == 0.0) continue;
+        const std::uint32_t r = inZone_[corners[k]] ? root(corners[k]) : kNone;
+        oneZone = oneZone && r != kNone && (!anyFree || r == zoneOfFree);
+        zoneOfFree = r;
+        anyFree = true;
+      }
+      const bool withHeld = !anyFree || oneZone;
+      std::uint32_t r = kNone;
+      for (const std::uint32_t v : corners) {
+        if (w_[v] == 0.0 && !withHeld) continue;
+        if (!inZone_[v]) {
+          inZone_[v] = 1;
+          members.push_back(v);
+          joined = true;
+        }
+        const std::uint32_t q = root(v);
+        if (r == kNone) {
+          r = q;
+        } else if (q != r) {
+          zone_[q] = r;
+          joined = true;
+        }
+      }
+    }
+    if (!joined || round > n) {
+      // Rounding alone (a zone moved by a translation its triangles do not survive on the exact
+      // grid): the zones go back to x0 exactly.
+      for (const std::uint32_t i : members) x_[i] = x0_[i];
+      ++stats_.fallbacks;
+      break;
+    }
+    sum.assign(n, Vec3{0.0});
+    weight.assign(n, 0.0);
+    std::vector<std::uint8_t>& heavy = heavy_;
+    heavy.assign(n, 0);
+    for (const std::uint32_t i : members) heavy[root(i)] |= w_[i] == 0.0;
+    for (const std::uint32_t i : members) {
+      const std::uint32_t r = root(i);
+      if (heavy[r] && w_[i] != 0.0) continue;
+      const Real mass = w_[i] == 0.0 ? 1.0 : 1.0 / w_[i];
+      sum[r] += (solved[i] - x0_[i]) * mass;
+      weight[r] += mass;
+    }
+    std::fill(triangleMoved_.begin(), triangleMoved_.end(), 0);
+    for (const std::uint32_t i : members) {
+      const std::uint32_t r = root(i);
+      const Vec3 moved = x0_[i] + sum[r] / weight[r];
+      if (moved != x_[i]) {
+        x_[i] = moved;
+        for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) triangleMoved_[vertexTriangles_[k]] = 1;
+      }
+    }
+  }
+  stats_.zoned += static_cast<std::int64_t>(members.size());
+  for (const std::uint32_t i : members) inZone_[i] = 0;
+}
+
+void SelfContact::scatter(std::vector<Cloth>& cloths) const {
+  std::size_t k = 0;
+  for (Cloth& cloth : cloths) {
+    ParticleState& s = cloth.state;
+    for (std::size_t i = 0; i < s.position.size(); ++i, ++k) s.position[i] = x_[k];
+  }
+}
+
+void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
+                        const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
+                        Workers& workers) {
+  std::size_t n = 0, nt = 0;
+  for (const Cloth& cloth : cloths) {
+    n += cloth.state.position.size();
+    nt += cloth.rest.triangles.size();
+  }
+  bool fresh = false;
+  if (topologyVersion != meshVersion_ || n != meshParticles_ || nt != triangles_.size()) {
+    buildMesh(cloths);
+    meshVersion_ = topologyVersion;
+    fresh = true;
+  }
+  gather(cloths, scratch);
+  // The pairs found at a substep serve the rest of its step while every particle, at x0 and now,
+  // keeps half a `distance` inside its box: two primitives within `distance` of each other are then
+  // still among them.
+  if (fresh || distance_ != settings.distance || !withinBoxes(0.5 * settings.distance)) {
+    // Looking ahead pays while the motion is smooth enough for the pairs to serve again; where they
+    // did not, the next boxes hold this substep's motion only.
+    findPairs(settings.distance, reused_ ? static_cast<Real>(std::max(substepsLeft, 1)) : 1.0, workers);
+    distance_ = settings.distance;
+    reused_ = false;
+  } else {
+    reused_ = true;
+  }
+  measurePairs(settings.distance, workers);
+  stats_.pairs = static_cast<std::int64_t>(pairs_.size());
+  sweep(settings.distance, settings.friction, scratch);
+  scatter(cloths);
+}
+
+void SelfContact::finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers) {
+  std::size_t k = 0;
+  for (const Cloth& cloth : cloths) {
+    for (const Vec3& x : cloth.state.position) x_[k++] = x;
+  }
+  failSafe(settings.distance, workers);
+  scatter(cloths);
+}
+
+}  // namespace drape::sim::contact

@@ -1,0 +1,118 @@
+// Self-contact between triangles: cloth that never passes through itself.
+//
+// Once a substep, after the constraint sweeps, over every cloth of the world at once:
+//
+// 1. Broad phase. Each particle's motion over the substep (from x0, where the substep started, to
+//    x, where the sweeps left it) is boxed, the box grown by `distance`; a triangle's and an edge's
+//    box holds its corners' boxes. A hashed grid pairs every particle with the triangles and every
+//    edge with the edges whose boxes its own overlaps (not those it is a corner or end of).
+// 2. Contacts. For each pair, the closest points at x0 (barycentric on the triangle, or along the
+//    two edges) and the direction between them, n. The contact keeps the two points at least the
+//    target apart along n: `distance`, or less for parts of one cloth closer than that at rest. It
+//    is linear in the positions, C(x) = sum_k c_k (n . x_k) - target >= 0 with sum_k c_k = 0, and
+//    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding). Then
+//    Coulomb friction in position form on each pair that was pushed: the tangential part of its
+//    relative motion, removed up to `friction` times the push.
+// 3. Fail-safe. Along the straight path from x0 to x, two primitives at x0-distance g can only
+//    meet if their corners' relative motion m (the largest |dx_i - dx_j| between a corner of one
+//    and of the other) reaches g. A pair with m < g is proven apart. For the others, the triangles
+//    around them are tested exactly (intersections.hpp's test, on the 2^-24 m grid) at x and at x0;
+//    where two of them intersect at x and did not at x0, their free corners go back to x0 (they
+//    stop for the substep). Then again, until no pair changes: every round puts back at least one
+//    particle for good, so it ends; with every free particle back, the cloth is where the substep
+//    found it. Only a patch fingers hold (or pins) can still be driven through (counted).
+//
+// A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
+// it would without self-contact. Deterministic whatever the number of threads: the pairs are listed
+// in parallel, each thread its run of particles and edges, joined in that order, and solved in it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "drape/sim/settings.hpp"
+#include "drape/sim/world.hpp"
+#include "workers.hpp"
+
+namespace drape::sim::contact {
+
+class SelfContact {
+ public:
+  // A substep's self-contact comes in two calls, and the world applies the colliders' friction
+  // between them (contact::friction), so that it answers to the weight the layers above put on a
+  // layer, and the fail-safe still has the last word. `scratch`: each cloth's collider contacts of
+  // this substep; the sweeps keep them too (a layer pushed down is not pushed through the table),
+  // and what they push out counts into the contact's depth, as the constraint sweeps' does.
+  // `substepsLeft`: in the step, this one included (the pairs found serve them all while they can).
+  void solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch, const SelfCollisionSettings& settings,
+             std::uint64_t topologyVersion, int substepsLeft, Workers& workers);
+  void finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers);
+  const SelfContactStats& stats() const { return stats_; }
+  std::size_t bytes() const;
+
+  struct Pair {
+    std::uint32_t v[4];           // vertex-triangle: the vertex, the triangle's corners; edge-edge: a0 a1 b0 b1
+    Real c[4];                    // the contact point's weights: (1, -b0, -b1, -b2) or (1 - s, s, -(1 - t), -t)
+    Vec3 normal;                  // at x0, from the second point to the first
+    Real gap0;                    // distance at x0, m
+    Real target;                  // m
+    Real push;                    // correction along the normal this substep, m (for friction)
+    std::uint32_t first, second;  // vertex and triangle, or the two edges
+    bool edges;
+  };
+
+ private:
+  void buildMesh(const std::vector<Cloth>& cloths);
+  void gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>& scratch);
+  void scatter(std::vector<Cloth>& cloths) const;
+  void findPairs(Real distance, Real ahead, Workers& workers);
+  void measurePairs(Real distance, Workers& workers);
+  void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
+  void failSafe(Real distance, Workers& workers);
+  bool withinBoxes(Real margin) const;
+
+  std::uint64_t meshVersion_ = 0;
+  std::size_t meshParticles_ = 0;
+  // The world's mesh, particles numbered across cloths.
+  std::vector<std::uint32_t> clothOf_;                        // per particle
+  std::vector<Vec3> rest_;                                    // rest positions
+  std::vector<glm::uvec3> triangles_;                         // world-wide corners
+  std::vector<glm::uvec2> edges_;                             // unique, lower particle first
+  std::vector<std::uint32_t> edgeTriangles_;                  // two per edge (kNone where only one)
+  std::vector<std::uint32_t> vertexStart_, vertexTriangles_;  // the triangles around each particle
+
+  // This substep.
+  std::vector<Vec3> x0_, x_;  // where each particle was when the substep began, and is now
+  Real distance_ = 0.0;       // the pairs were found for
+  bool reused_ = true;        // the pairs last found served a second substep
+  std::vector<Real> w_;       // inverse masses
+  struct Plane {
+    std::uint32_t particle;
+    std::uint32_t cloth, index;  // of the particle in its cloth
+    Vec3 normal;
+    Real offset;  // the particle keeps normal . x >= offset
+  };
+  std::vector<Plane> planes_;        // the collider contacts of this substep
+  std::vector<Vec3> lower_, upper_;  // boxes of the particles, triangles, edges: in that order
+  struct Entry {
+    std::uint64_t cell;  // its cell's three coordinates, packed
+    std::uint32_t index;
+    glm::vec3 lower, upper;  // its box, rounded outwards
+  };
+  struct Grid {
+    std::vector<std::uint32_t> start;
+    std::vector<Entry> entries;
+  } triangleGrid_, edgeGrid_;
+  Real cellSize_ = 1.0;
+  std::vector<std::vector<Pair>> found_;  // per thread
+  std::vector<Pair> pairs_;
+  std::vector<std::uint32_t> active_;  // pairs the sweeps look at
+  // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is
+  // in a zone, and (per zone root) whether a held or pinned particle is in it; per triangle, whether
+  // the last round moved a corner.
+  std::vector<std::uint32_t> zone_;
+  std::vector<std::uint8_t> inZone_, heavy_, triangleMoved_;
+  SelfContactStats stats_;
+};
+
+}  // namespace drape::sim::contact
