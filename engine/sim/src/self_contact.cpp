@@ -23,6 +23,8 @@ constexpr int kSweeps = 4;
 constexpr Real kProofMargin = 1e-6;
 // Two points closer than this at x0 give no direction to keep apart along.
 constexpr Real kCoincident = 1e-12;
+// How many times its rest size a triangle or edge may be stretched and still take part.
+constexpr Real kTorn = 10.0;
 
 // `inverse`: 1 / the cell's size.
 glm::i64vec3 cellOf(Vec3 x, Real inverse) {
@@ -157,7 +159,9 @@ bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, co
   const auto cellsOf = [&](std::size_t i) {
     return std::pair{cellOf(Vec3(below(build.lower[i])), inverse), cellOf(Vec3(above(build.upper[i])), inverse)};
   };
+  const auto empty = [&](std::size_t i) { return build.lower[i].x > build.upper[i].x; };
   for (std::size_t i = 0; i < build.count; ++i) {
+    if (empty(i)) continue;
     const auto [lo, hi] = cellsOf(i);
     total += cellsIn(lo, hi);
     if (total > budget) return false;
@@ -173,11 +177,14 @@ bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, co
       }
     }
   };
-  for (std::size_t i = 0; i < build.count; ++i) each(i, [&](glm::i64vec3 c) { ++start[hashOf(c, mask) + 1]; });
+  for (std::size_t i = 0; i < build.count; ++i) {
+    if (!empty(i)) each(i, [&](glm::i64vec3 c) { ++start[hashOf(c, mask) + 1]; });
+  }
   for (std::size_t k = 0; k < table; ++k) start[k + 1] += start[k];
   std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
   entries.resize(static_cast<std::size_t>(total));
   for (std::size_t i = 0; i < build.count; ++i) {
+    if (empty(i)) continue;
     const glm::vec3 lo = below(build.lower[i]), hi = above(build.upper[i]);
     each(i, [&](glm::i64vec3 c) {
       const std::uint32_t k = fill[hashOf(c, mask)]++;
@@ -280,15 +287,36 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   lower_.resize(n + nt + ne);
   upper_.resize(n + nt + ne);
   Real extent = 0.0;
+  std::size_t kept = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 to = x0_[i] + (x_[i] - x0_[i]) * ahead;
     lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
     upper_[i] = glm::max(glm::max(x0_[i], x_[i]), to) + grow;
   }
+  // A triangle or edge stretched past kTorn times its rest size is no cloth any more (a finger flung
+  // its patch 100 m): it takes no part, or its box would pair it with everything in between.
+  const auto longest = [&](const std::vector<Vec3>& x, const std::uint32_t* v, int count) {
+    Real most = 0.0;
+    for (int i = 0; i < count; ++i) {
+      const Vec3 d = x[v[i]] - x[v[(i + 1) % count]];
+      most = std::max(most, glm::dot(d, d));
+    }
+    return most;
+  };
+  const auto torn = [&](const std::uint32_t* v, int count) {
+    return longest(x_, v, count) > kTorn * kTorn * longest(rest_, v, count) + 4.0 * grow * grow;
+  };
+  const Vec3 none(std::numeric_limits<Real>::max());
   for (std::size_t t = 0; t < nt; ++t) {
     const glm::uvec3 v = triangles_[t];
+    if (torn(&triangles_[t][0], 3)) {
+      lower_[n + t] = none;
+      upper_[n + t] = -none;
+      continue;
+    }
     lower_[n + t] = glm::min(glm::min(lower_[v[0]], lower_[v[1]]), lower_[v[2]]);
     upper_[n + t] = glm::max(glm::max(upper_[v[0]], upper_[v[1]]), upper_[v[2]]);
+    ++kept;
     // The cells' size comes from the triangles as they are (plus the growth), not as they sweep:
     // a patch a finger flings far covers many cells instead of making every cell hold everything.
     const Vec3 size =
@@ -297,12 +325,17 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   }
   for (std::size_t e = 0; e < ne; ++e) {
     const glm::uvec2 v = edges_[e];
+    if (torn(&edges_[e][0], 2)) {
+      lower_[n + nt + e] = none;
+      upper_[n + nt + e] = -none;
+      continue;
+    }
     lower_[n + nt + e] = glm::min(lower_[v[0]], lower_[v[1]]);
     upper_[n + nt + e] = glm::max(upper_[v[0]], upper_[v[1]]);
   }
   // Cells about a triangle's box wide; wider while a few huge boxes (a particle flung far) would
   // fill the grid.
-  cellSize_ = nt > 0 ? std::max(1.5 * extent / static_cast<Real>(nt), 1e-6) : 1.0;
+  cellSize_ = kept > 0 ? std::max(1.5 * extent / static_cast<Real>(kept), 1e-6) : 1.0;
   const std::uint64_t budget = 16 * static_cast<std::uint64_t>(nt + ne) + (1u << 20);
   while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, {lower_.data() + n, upper_.data() + n, nt},
                    1.0 / cellSize_, budget) ||
