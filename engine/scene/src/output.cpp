@@ -143,8 +143,17 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
   document["steps"] = world.stepCount();
   document["time"] = world.time();
   const sim::IntersectionCount intersections = sim::countIntersections(world);
+  const sim::SelfContactStats contact = world.selfContactStats();
   document["metrics"] = {{"strain", {{"max", strain.max}, {"mean", strain.mean}, {"constraints", strain.count}}},
                          {"intersections", {{"pairs", intersections.pairs}, {"skipped", intersections.skipped}}},
+                         {"selfContact",
+                          {{"pairs", contact.pairs},
+                           {"pushed", contact.pushed},
+                           {"searches", contact.searches},
+                           {"tested", contact.tested},
+                           {"triangleTests", contact.triangleTests},
+                           {"zoned", contact.zoned},
+                           {"fallbacks", contact.fallbacks}}},
                          {"energy",
                           {{"kinetic", energy.kinetic},
                            {"gravitational", energy.gravitational},

@@ -23,6 +23,10 @@ constexpr int kSweeps = 4;
 constexpr Real kProofMargin = 1e-6;
 // Two points closer than this at x0 give no direction to keep apart along.
 constexpr Real kCoincident = 1e-12;
+// A pair whose free corners would each move more than 1 / kLeverage times as far as its points part
+// pushes nothing: a free corner of weight 0.004 in a triangle whose other corners and the vertex
+// fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair apart instead.
+constexpr Real kLeverage = 0.25;
 // How many times its rest size a triangle or edge may be stretched and still take part.
 constexpr Real kTorn = 10.0;
 
@@ -125,8 +129,8 @@ Vec3 between(const Weights& w, const Vec3& p0, const Vec3& p1, const Vec3& p2, c
 }
 
 struct GridBuild {
-  const Vec3* lower;
-  const Vec3* upper;
+  const glm::vec3* lower;  // the boxes in single precision, rounded outwards
+  const glm::vec3* upper;
   std::size_t count;
 };
 
@@ -157,7 +161,7 @@ bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, co
   // Cells from the boxes as the entries keep them (single precision, rounded outwards): a pair's
   // overlap then lies in cells both cover (query below).
   const auto cellsOf = [&](std::size_t i) {
-    return std::pair{cellOf(Vec3(below(build.lower[i])), inverse), cellOf(Vec3(above(build.upper[i])), inverse)};
+    return std::pair{cellOf(Vec3(build.lower[i]), inverse), cellOf(Vec3(build.upper[i]), inverse)};
   };
   const auto empty = [&](std::size_t i) { return build.lower[i].x > build.upper[i].x; };
   for (std::size_t i = 0; i < build.count; ++i) {
@@ -185,10 +189,12 @@ bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, co
   entries.resize(static_cast<std::size_t>(total));
   for (std::size_t i = 0; i < build.count; ++i) {
     if (empty(i)) continue;
-    const glm::vec3 lo = below(build.lower[i]), hi = above(build.upper[i]);
+    const glm::i64vec3 first = cellOf(Vec3(build.lower[i]), inverse);
     each(i, [&](glm::i64vec3 c) {
       const std::uint32_t k = fill[hashOf(c, mask)]++;
-      entries[k] = {packed(c), static_cast<std::uint32_t>(i), lo, hi};
+      const auto starts =
+          static_cast<std::uint8_t>((c.x == first.x ? 1 : 0) | (c.y == first.y ? 2 : 0) | (c.z == first.z ? 4 : 0));
+      entries[k] = {packed(c), static_cast<std::uint32_t>(i), starts, build.lower[i], build.upper[i]};
     });
   }
   return true;
@@ -199,8 +205,9 @@ bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, co
 std::size_t SelfContact::bytes() const {
   const auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   std::size_t total = b(clothOf_) + b(rest_) + b(triangles_) + b(edges_) + b(edgeTriangles_) + b(vertexStart_) +
-                      b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) + b(upper_) + b(pairs_) +
-                      b(active_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_);
+                      b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) + b(upper_) + b(boxLower_) +
+                      b(boxUpper_) + b(pairs_) + b(active_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) +
+                      b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
   for (const Grid* g : {&triangleGrid_, &edgeGrid_}) total += b(g->start) + b(g->entries);
   for (const std::vector<Pair>& found : found_) total += b(found);
   return total;
@@ -336,23 +343,30 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   // Cells about a triangle's box wide; wider while a few huge boxes (a particle flung far) would
   // fill the grid.
   cellSize_ = kept > 0 ? std::max(1.5 * extent / static_cast<Real>(kept), 1e-6) : 1.0;
+  // The boxes as the grid keeps them: single precision, rounded outwards.
+  boxLower_.resize(n + nt + ne);
+  boxUpper_.resize(n + nt + ne);
+  for (std::size_t i = 0; i < n + nt + ne; ++i) {
+    boxLower_[i] = below(lower_[i]);
+    boxUpper_[i] = above(upper_[i]);
+  }
   const std::uint64_t budget = 16 * static_cast<std::uint64_t>(nt + ne) + (1u << 20);
-  while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, {lower_.data() + n, upper_.data() + n, nt},
+  while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, {boxLower_.data() + n, boxUpper_.data() + n, nt},
                    1.0 / cellSize_, budget) ||
-         !fillGrid(edgeGrid_.start, edgeGrid_.entries, {lower_.data() + n + nt, upper_.data() + n + nt, ne},
+         !fillGrid(edgeGrid_.start, edgeGrid_.entries, {boxLower_.data() + n + nt, boxUpper_.data() + n + nt, ne},
                    1.0 / cellSize_, budget)) {
     cellSize_ *= 2.0;
   }
 
+  ++stats_.searches;
   found_.resize(static_cast<std::size_t>(workers.threads()));
   for (std::vector<Pair>& found : found_) found.clear();
   // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap.
   // `accept(other)` first: a cheap test of the pair by its indices.
   const auto query = [&](const Grid& grid, std::size_t self, auto&& accept, auto&& emit) {
-    const glm::vec3 lo = below(lower_[self]), hi = above(upper_[self]);
+    const glm::vec3 lo = boxLower_[self], hi = boxUpper_[self];
     const Real inverse = 1.0 / cellSize_;
     const glm::i64vec3 from = cellOf(Vec3(lo), inverse), to = cellOf(Vec3(hi), inverse);
-    const bool oneCell = from == to;  // then every overlap lies in it
     const std::size_t mask = grid.start.size() - 2;
     for (std::int64_t z = from.z; z <= to.z; ++z) {
       for (std::int64_t y = from.y; y <= to.y; ++y) {
@@ -360,15 +374,18 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
           const glm::i64vec3 cell(x, y, z);
           const std::uint64_t key = packed(cell);
           const std::size_t bucket = hashOf(cell, mask);
+          // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap. Along
+          // an axis where this cell is past the query's first, that is where the entry's box starts.
+          const auto needs =
+              static_cast<std::uint8_t>((x != from.x ? 1 : 0) | (y != from.y ? 2 : 0) | (z != from.z ? 4 : 0));
           for (std::uint32_t k = grid.start[bucket]; k < grid.start[bucket + 1]; ++k) {
             const Entry& e = grid.entries[k];
-            if (e.cell != key || !accept(e.index)) continue;
+            if (e.cell != key || (e.starts & needs) != needs) continue;
             if (!(lo.x <= e.upper.x && e.lower.x <= hi.x && lo.y <= e.upper.y && e.lower.y <= hi.y &&
                   lo.z <= e.upper.z && e.lower.z <= hi.z)) {
               continue;
             }
-            // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap.
-            if (!oneCell && cellOf(Vec3(glm::max(lo, e.lower)), inverse) != cell) continue;
+            if (!accept(e.index)) continue;
             emit(e.index);
           }
         }
@@ -473,17 +490,17 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
     return g;
   };
   // How far each unit the two points must part moves the particles: 1 / sum_k c_k^2 w_k, so that
-  // the masses share the move; less where that would move one particle more than the points part
-  // (a held vertex against a triangle whose only free corner has a small weight there: the pair is
-  // then left to the fail-safe rather than the corner flung).
+  // the masses share the move; nothing where that would move a particle more than 1 / kLeverage
+  // times as far as the points part (a held vertex against a triangle whose only free corner has a
+  // small weight there: the pair is then left to the fail-safe rather than the corner flung).
   const auto reach = [&](const Pair& p) {
     Real denominator = 0.0, most = 0.0;
     for (int k = 0; k < 4; ++k) {
       denominator += p.c[k] * p.c[k] * w_[p.v[k]];
       most = std::max(most, std::abs(p.c[k]) * w_[p.v[k]]);
     }
-    if (!(denominator > 0.0)) return 0.0;
-    return std::min(1.0 / denominator, 1.0 / most);
+    if (!(denominator > kLeverage * most)) return 0.0;
+    return 1.0 / denominator;
   };
   // Whether the two points still face each other across the normal: their offset along the
   // surface within the size of the primitives (else one slid off the other's side, or a finger
@@ -573,27 +590,50 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     return i;
   };
   const std::vector<Vec3> solved = x_;  // each particle's motion as the contacts left it
-  const auto triangleAt = [&](const std::vector<Vec3>& x, std::uint32_t t) {
-    const glm::uvec3 c = triangles_[t];
-    return exact::makeTriangle(x[c[0]], x[c[1]], x[c[2]], {c[0], c[1], c[2]});
+  // The exact triangles the tests need, each made once: at x0 once a substep, at x again only where
+  // a zone moved a corner. `slot`: per triangle, where in `made` it is (kNone: not yet).
+  struct Made {
+    std::vector<std::uint32_t>& slot;
+    std::vector<std::optional<exact::Triangle>>& made;
+    std::vector<std::uint32_t>& which;  // the triangles made, to clear their slots
   };
-  // Whether triangles s and t intersect now and did not at x0.
-  // Particles of one cloth at one grid point are one corner, as the counter has them
-  // (countIntersections): the copies a tear makes, before the seam opens.
-  const auto through = [&](std::optional<exact::Triangle> a, std::optional<exact::Triangle> b) {
+  Made at0{slot0_, made0_, which0_}, atX{slotX_, madeX_, whichX_};
+  for (Made* m : {&at0, &atX}) {
+    m->slot.resize(triangles_.size(), kNone);
+    m->made.clear();
+    m->which.clear();
+  }
+  const auto make = [&](Made& m, const std::vector<Vec3>& x, std::uint32_t t) {
+    if (m.slot[t] == kNone) {
+      const glm::uvec3 c = triangles_[t];
+      m.slot[t] = static_cast<std::uint32_t>(m.made.size());
+      m.made.push_back(exact::makeTriangle(x[c[0]], x[c[1]], x[c[2]], {c[0], c[1], c[2]}));
+      m.which.push_back(t);
+    }
+  };
+  // Whether triangles a and b intersect. Particles of one cloth at one grid point are one corner,
+  // as the counter has them (countIntersections): the copies a tear makes, before the seam opens.
+  const auto through = [&](const std::optional<exact::Triangle>& a, const std::optional<exact::Triangle>& b) {
     if (!a || !b) return false;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (a->upper[axis] < b->lower[axis] || b->upper[axis] < a->lower[axis]) return false;
+    }
+    const auto copies = [&](int i, int j) {
+      return a->particle[i] != b->particle[j] && a->p[i] == b->p[j] &&
+             clothOf_[a->particle[i]] == clothOf_[b->particle[j]];
+    };
+    bool any = false;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) any = any || copies(i, j);
+    }
+    if (!any) return exact::intersect(*a, *b);
+    exact::Triangle unified = *b;
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) {
-        if (a->particle[i] != b->particle[j] && a->p[i] == b->p[j] &&
-            clothOf_[a->particle[i]] == clothOf_[b->particle[j]]) {
-          b->particle[j] = a->particle[i];
-        }
+        if (copies(i, j)) unified.particle[j] = a->particle[i];
       }
     }
-    return exact::intersect(*a, *b);
-  };
-  const auto newlyThrough = [&](std::uint32_t s, std::uint32_t t) {
-    return through(triangleAt(x_, s), triangleAt(x_, t)) && !through(triangleAt(x0_, s), triangleAt(x0_, t));
+    return exact::intersect(*a, unified);
   };
   // The triangles the fail-safe tests for a pair: around its vertex against its triangle, or those
   // on its first edge against those on its second.
@@ -614,9 +654,11 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
   std::vector<std::uint32_t> members;  // particles in a zone of more than one
   std::vector<Vec3> sum;               // per zone root: mass-weighted motion
   std::vector<Real> weight;
+  std::vector<std::uint64_t>& tests = tests_;
+  std::vector<std::uint8_t>& hits = hits_;
   // Every round but the last joins two zones or more: at most one round a particle.
   for (std::uint32_t round = 1;; ++round) {
-    passing.clear();
+    tests.clear();
     for (const Pair& p : pairs_) {
       if (round > 1) {
         // After the first round, only pairs whose tests a zone's move changed.
@@ -636,8 +678,35 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
       if (p.gap0 > std::sqrt(m) + kProofMargin) continue;  // proven apart all the way
       ++stats_.tested;
       eachTest(p, [&](std::uint32_t s, std::uint32_t t) {
-        if (newlyThrough(s, t)) passing.push_back({s, t});
+        tests.push_back((static_cast<std::uint64_t>(std::min(s, t)) << 32) | std::max(s, t));
       });
+    }
+    // Each pair of triangles once (pairs of primitives share them), in order.
+    std::sort(tests.begin(), tests.end());
+    tests.erase(std::unique(tests.begin(), tests.end()), tests.end());
+    stats_.triangleTests += static_cast<std::int64_t>(tests.size());
+    for (const std::uint64_t key : tests) {
+      make(atX, x_, static_cast<std::uint32_t>(key >> 32));
+      make(atX, x_, static_cast<std::uint32_t>(key));
+    }
+    hits.assign(tests.size(), 0);
+    workers.run(
+        tests.size(),
+        [&](std::size_t begin, std::size_t end, int) {
+          for (std::size_t i = begin; i < end; ++i) {
+            const std::uint64_t key = tests[i];
+            hits[i] = through(madeX_[slotX_[key >> 32]], madeX_[slotX_[static_cast<std::uint32_t>(key)]]);
+          }
+        },
+        256);
+    // Of those that intersect now, the ones that did not at x0.
+    passing.clear();
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+      if (!hits[i]) continue;
+      const auto s = static_cast<std::uint32_t>(tests[i] >> 32), t = static_cast<std::uint32_t>(tests[i]);
+      make(at0, x0_, s);
+      make(at0, x0_, t);
+      if (!through(made0_[slot0_[s]], made0_[slot0_[t]])) passing.push_back({s, t});
     }
     if (passing.empty()) break;
     // A pair's free corners join one zone, which moves as one body from x0 by the mass-weighted mean
@@ -704,6 +773,12 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
         for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) triangleMoved_[vertexTriangles_[k]] = 1;
       }
     }
+    for (const std::uint32_t t : whichX_) {
+      if (triangleMoved_[t]) slotX_[t] = kNone;  // made again where the next round needs it
+    }
+  }
+  for (Made* m : {&at0, &atX}) {
+    for (const std::uint32_t t : m->which) m->slot[t] = kNone;
   }
   stats_.zoned += static_cast<std::int64_t>(members.size());
   for (const std::uint32_t i : members) inZone_[i] = 0;

@@ -28,10 +28,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
+#include "exact_triangles.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::contact {
@@ -92,11 +94,13 @@ class SelfContact {
     Vec3 normal;
     Real offset;  // the particle keeps normal . x >= offset
   };
-  std::vector<Plane> planes_;        // the collider contacts of this substep
-  std::vector<Vec3> lower_, upper_;  // boxes of the particles, triangles, edges: in that order
+  std::vector<Plane> planes_;                   // the collider contacts of this substep
+  std::vector<Vec3> lower_, upper_;             // boxes of the particles, triangles, edges: in that order
+  std::vector<glm::vec3> boxLower_, boxUpper_;  // the same in single precision, rounded outwards
   struct Entry {
     std::uint64_t cell;  // its cell's three coordinates, packed
     std::uint32_t index;
+    std::uint8_t starts;     // bit k: its box starts in this cell along axis k
     glm::vec3 lower, upper;  // its box, rounded outwards
   };
   struct Grid {
@@ -112,6 +116,13 @@ class SelfContact {
   // the last round moved a corner.
   std::vector<std::uint32_t> zone_;
   std::vector<std::uint8_t> inZone_, heavy_, triangleMoved_;
+  // Its exact tests: the pairs of triangles of a round (lower index in the high word) and whether
+  // each intersects now; the exact triangles made at x0 and at x (slot per triangle, kNone if not
+  // made, and the triangles made).
+  std::vector<std::uint64_t> tests_;
+  std::vector<std::uint8_t> hits_;
+  std::vector<std::uint32_t> slot0_, slotX_, which0_, whichX_;
+  std::vector<std::optional<exact::Triangle>> made0_, madeX_;
   SelfContactStats stats_;
 };
 

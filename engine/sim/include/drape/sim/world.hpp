@@ -61,11 +61,13 @@ enum class StepStatus : std::uint8_t { ok, diverged };
 
 // What self-contact between triangles (selfCollision.method triangles) did.
 struct SelfContactStats {
-  std::int64_t pairs = 0;      // last substep: vertex-triangle and edge-edge pairs the broad phase found
-  std::int64_t pushed = 0;     // last substep: of them, pushed apart
-  std::int64_t tested = 0;     // since the world was made: pairs not proven apart, tested exactly
-  std::int64_t zoned = 0;      // since made: particles the fail-safe moved as one body with others (a zone)
-  std::int64_t fallbacks = 0;  // since made: substeps whose zones went back to where they began
+  std::int64_t pairs = 0;          // last substep: vertex-triangle and edge-edge pairs the broad phase found
+  std::int64_t pushed = 0;         // last substep: of them, pushed apart
+  std::int64_t tested = 0;         // since the world was made: pairs not proven apart, tested exactly
+  std::int64_t zoned = 0;          // since made: particles the fail-safe moved as one body with others (a zone)
+  std::int64_t fallbacks = 0;      // since made: substeps whose zones went back to where they began
+  std::int64_t searches = 0;       // since made: broad-phase searches (the pairs found anew)
+  std::int64_t triangleTests = 0;  // since made: exact triangle-triangle tests by the fail-safe
 };
 
 class Workers;
