@@ -360,9 +360,8 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
 
   ++stats_.searches;
   found_.resize(static_cast<std::size_t>(workers.threads()));
-  for (std::vector<Pair>& found : found_) found.clear();
   // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap.
-  // `accept(other)` first: a cheap test of the pair by its indices.
+  // `accept(other)`: a cheap test of the pair by its indices, after the boxes'.
   const auto query = [&](const Grid& grid, std::size_t self, auto&& accept, auto&& emit) {
     const glm::vec3 lo = boxLower_[self], hi = boxUpper_[self];
     const Real inverse = 1.0 / cellSize_;
@@ -392,62 +391,59 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
       }
     }
   };
-  // Vertex-triangle pairs, each thread its run of particles.
-  workers.run(
-      n,
-      [&](std::size_t begin, std::size_t end, int thread) {
-        std::vector<Pair>& found = found_[static_cast<std::size_t>(thread)];
-        for (std::size_t v = begin; v < end; ++v) {
-          const auto notCorner = [&](std::uint32_t t) {
-            const glm::uvec3 c = triangles_[t];
-            return c[0] != v && c[1] != v && c[2] != v;
-          };
-          query(triangleGrid_, v, notCorner, [&](std::uint32_t t) {
-            const glm::uvec3 c = triangles_[t];
-            Pair pair{};
-            pair.v[0] = static_cast<std::uint32_t>(v);
-            pair.v[1] = c[0];
-            pair.v[2] = c[1];
-            pair.v[3] = c[2];
-            pair.first = static_cast<std::uint32_t>(v);
-            pair.second = t;
-            pair.edges = false;
-            found.push_back(pair);
-          });
-        }
-      },
-      256);
+  // Every primitive `self` of [0, count) (its box at `boxes + self`) against `grid`, each thread its
+  // run, joined in that order onto pairs_. `accept(self, other)`: a cheap test by indices first.
+  const auto list = [&](std::size_t count, const Grid& grid, std::size_t boxes, auto&& accept, auto&& corners,
+                        bool edges) {
+    for (std::vector<Pair>& found : found_) found.clear();
+    workers.run(
+        count,
+        [&](std::size_t begin, std::size_t end, int thread) {
+          std::vector<Pair>& found = found_[static_cast<std::size_t>(thread)];
+          for (std::size_t self = begin; self < end; ++self) {
+            const auto first = static_cast<std::uint32_t>(self);
+            query(
+                grid, boxes + self, [&](std::uint32_t other) { return accept(first, other); },
+                [&](std::uint32_t other) {
+                  Pair pair{};
+                  corners(first, other, pair.v);
+                  pair.first = first;
+                  pair.second = other;
+                  pair.edges = edges;
+                  found.push_back(pair);
+                });
+          }
+        },
+        256);
+    for (const std::vector<Pair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
+  };
   pairs_.clear();
-  for (const std::vector<Pair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
-  for (std::vector<Pair>& found : found_) found.clear();
-  // Edge-edge pairs, each thread its run of edges; each pair from its lower edge.
-  workers.run(
-      ne,
-      [&](std::size_t begin, std::size_t end, int thread) {
-        std::vector<Pair>& found = found_[static_cast<std::size_t>(thread)];
-        for (std::size_t e = begin; e < end; ++e) {
-          const glm::uvec2 a = edges_[e];
-          const auto apart = [&](std::uint32_t f) {
-            if (f <= e) return false;
-            const glm::uvec2 b = edges_[f];
-            return a[0] != b[0] && a[0] != b[1] && a[1] != b[0] && a[1] != b[1];
-          };
-          query(edgeGrid_, n + nt + e, apart, [&](std::uint32_t f) {
-            const glm::uvec2 b = edges_[f];
-            Pair pair{};
-            pair.v[0] = a[0];
-            pair.v[1] = a[1];
-            pair.v[2] = b[0];
-            pair.v[3] = b[1];
-            pair.first = static_cast<std::uint32_t>(e);
-            pair.second = f;
-            pair.edges = true;
-            found.push_back(pair);
-          });
-        }
+  // Vertex-triangle pairs: a vertex against the triangles it is no corner of.
+  list(
+      n, triangleGrid_, 0,
+      [&](std::uint32_t v, std::uint32_t t) {
+        const glm::uvec3 c = triangles_[t];
+        return c[0] != v && c[1] != v && c[2] != v;
       },
-      256);
-  for (const std::vector<Pair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
+      [&](std::uint32_t v, std::uint32_t t, std::uint32_t* corners) {
+        corners[0] = v;
+        for (int k = 0; k < 3; ++k) corners[k + 1] = triangles_[t][k];
+      },
+      false);
+  // Edge-edge pairs: each pair from its lower edge, of edges that share no end.
+  list(
+      ne, edgeGrid_, n + nt,
+      [&](std::uint32_t e, std::uint32_t f) {
+        const glm::uvec2 a = edges_[e], b = edges_[f];
+        return f > e && a[0] != b[0] && a[0] != b[1] && a[1] != b[0] && a[1] != b[1];
+      },
+      [&](std::uint32_t e, std::uint32_t f, std::uint32_t* corners) {
+        corners[0] = edges_[e][0];
+        corners[1] = edges_[e][1];
+        corners[2] = edges_[f][0];
+        corners[3] = edges_[f][1];
+      },
+      true);
 }
 
 void SelfContact::measurePairs(Real distance, Workers& workers) {
