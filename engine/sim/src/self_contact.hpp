@@ -10,17 +10,20 @@
 //    two edges) and the direction between them, n. The contact keeps the two points at least the
 //    target apart along n: `distance`, or less for parts of one cloth closer than that at rest. It
 //    is linear in the positions, C(x) = sum_k c_k (n . x_k) - target >= 0 with sum_k c_k = 0, and
-//    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding). Then
+//    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding), except
+//    where that would move a particle far more than the points part (kLeverage). Then
 //    Coulomb friction in position form on each pair that was pushed: the tangential part of its
 //    relative motion, removed up to `friction` times the push.
 // 3. Fail-safe. Along the straight path from x0 to x, two primitives at x0-distance g can only
 //    meet if their corners' relative motion m (the largest |dx_i - dx_j| between a corner of one
 //    and of the other) reaches g. A pair with m < g is proven apart. For the others, the triangles
-//    around them are tested exactly (intersections.hpp's test, on the 2^-24 m grid) at x and at x0;
-//    where two of them intersect at x and did not at x0, their free corners go back to x0 (they
-//    stop for the substep). Then again, until no pair changes: every round puts back at least one
-//    particle for good, so it ends; with every free particle back, the cloth is where the substep
-//    found it. Only a patch fingers hold (or pins) can still be driven through (counted).
+//    around them are tested exactly (intersections.hpp's test, on the 2^-24 m grid) at x and at x0,
+//    each pair of triangles once a round; where two of them intersect at x and did not at x0, their
+//    free corners join an impact zone, which moves rigidly from x0 by its mass-weighted mean motion
+//    (as it was at x0, so intersection-free, and with its momentum). Held and pinned corners join
+//    only where a zone of free ones still passes through them (then they count as infinitely heavy
+//    and the grip slips for the substep). Then again, until no pair changes: zones only grow, so it
+//    ends; in the worst case everything moves as one body.
 //
 // A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
 // it would without self-contact. Deterministic whatever the number of threads: the pairs are listed
