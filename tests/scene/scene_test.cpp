@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/scene/error.hpp"
+#include "drape/scene/fabric.hpp"
 #include "drape/scene/output.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/scene/snapshot.hpp"
@@ -174,6 +175,42 @@ std::string errorOf(const std::function<void()>& action) {
     return error.what();
   }
   return "(no error)";
+}
+
+TEST(SceneReader, AFabricIsAPresetOrItsNumbersAndRefusesWhatItReplaces) {
+  json document = minimal();
+  applyOverride(document, "cloths.0.fabric=denim");
+  const sim::ClothSettings denim = parseScene(document, "s.json").world.cloths.at(0);
+  ASSERT_TRUE(denim.fabric.has_value());
+  EXPECT_DOUBLE_EQ(denim.fabric->arealDensity, 0.324);
+  EXPECT_DOUBLE_EQ(denim.fabric->bendingRigidity, 6.4e-5);
+
+  document = minimal();
+  document["cloths"][0]["fabric"] = json::parse(R"({"preset": "silk", "bendingRigidity": 4e-6})");
+  const sim::ClothSettings silk = parseScene(document, "s.json").world.cloths.at(0);
+  EXPECT_DOUBLE_EQ(silk.fabric->arealDensity, fabricPreset("silk")->arealDensity);
+  EXPECT_DOUBLE_EQ(silk.fabric->bendingRigidity, 4e-6);
+
+  document = minimal();
+  applyOverride(document, "cloths.0.fabric=tweed");
+  EXPECT_NE(
+      errorOf([&] { parseScene(document, "s.json"); }).find("s.json: cloths.0.fabric: expected a fabric preset (silk"),
+      std::string::npos);
+  applyOverride(document, "cloths.0.fabric=cotton");
+  applyOverride(document, "cloths.0.mass=2");
+  EXPECT_NE(errorOf([&] { parseScene(document, "s.json"); }).find("s.json: cloths.0.mass: expected no \"mass\""),
+            std::string::npos);
+  document = minimal();
+  document["cloths"][0]["fabric"] = json::parse(R"({"bendingRigidity": -1})");
+  EXPECT_NE(errorOf([&] { parseScene(document, "s.json"); }).find("cloths.0.fabric.bendingRigidity"),
+            std::string::npos);
+  document = minimal();
+  applyOverride(document, "cloths.0.fabric=cotton");
+  applyOverride(document, "solver.model=force");
+  applyOverride(document, "solver.integrator=rk4");
+  EXPECT_NE(
+      errorOf([&] { parseScene(document, "s.json"); }).find("cloths.0.fabric: expected no fabric in the force model"),
+      std::string::npos);
 }
 
 TEST(Overrides, BadAssignmentsAreErrorsNamingTheOption) {

@@ -1,4 +1,5 @@
 #include "drape/scene/scene.hpp"
+#include "drape/scene/fabric.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -68,6 +69,50 @@ KindMaterial readMaterial(ObjectReader& cloth, ConstraintKind kind, Model model,
   return material;
 }
 
+// "fabric": a preset's name, or an object of the four numbers (each optional over "preset", or
+// over cotton's). A fabric's mass follows from its area and its materials from its stiffnesses, so
+// "mass", "masses" and the kinds' stiffness and compliance keys are refused beside it.
+std::optional<sim::Fabric> readFabric(ObjectReader& cloth, Model model) {
+  if (!cloth.has("fabric")) return std::nullopt;
+  if (model != Model::position) {
+    cloth.fail("fabric", "no fabric in the force model (it needs \"model\": \"position\")", cloth.raw("fabric"));
+  }
+  for (const char* key : {"mass", "masses"}) {
+    if (cloth.has(key)) cloth.fail(key, "no \"mass\" beside \"fabric\" (its areal density weighs it)", cloth.raw(key));
+  }
+  for (ConstraintKind kind : sim::kConstraintKinds) {
+    const std::string_view key = sim::name(kind);
+    if (cloth.has(key)) {
+      cloth.fail(key, "no stretch, shear or bend materials beside \"fabric\" (they follow from it)", cloth.raw(key));
+    }
+  }
+  std::string names;
+  for (const FabricPreset& preset : fabricPresets()) names += (names.empty() ? "" : ", ") + std::string(preset.name);
+  const json* value = cloth.raw("fabric");
+  const auto named = [&](const json& text, const std::string& path) {
+    if (!text.is_string() || !fabricPreset(text.get<std::string>())) {
+      failAt(cloth.source(), path, "a fabric preset (" + names + ")", &text);
+    }
+    return *fabricPreset(text.get<std::string>());
+  };
+  if (value->is_string()) {
+    (void)cloth.text("fabric", "");
+    return named(*value, cloth.pathOf("fabric"));
+  }
+  ObjectReader reader = cloth.object("fabric");
+  sim::Fabric fabric = *fabricPreset("cotton");
+  if (reader.has("preset")) {
+    fabric = named(*reader.raw("preset"), reader.pathOf("preset"));
+    (void)reader.text("preset", "");
+  }
+  fabric.arealDensity = reader.number("arealDensity", fabric.arealDensity, {1.0e-3, 10.0, false, "kg/m^2"});
+  fabric.bendingRigidity = reader.number("bendingRigidity", fabric.bendingRigidity, {1.0e-9, 1.0, false, "N m"});
+  fabric.stretchStiffness = reader.number("stretchStiffness", fabric.stretchStiffness, {1.0, 1.0e7, false, "N/m"});
+  fabric.shearStiffness = reader.number("shearStiffness", fabric.shearStiffness, {1.0e-2, 1.0e7, false, "N/m"});
+  reader.finish();
+  return fabric;
+}
+
 constexpr std::size_t kMaxOutlinePoints = 100000;
 
 // The lattice particle at `particle`: [column, row] inside the grid.
@@ -126,6 +171,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
       throw InputError(reader.source() + ": " + reader.pathOf("outline") + ": " + error.what());
     }
     cloth.outline = std::move(outline);
+    cloth.fabric = readFabric(reader, model);
     cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
     cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
     cloth.thickness = reader.number("thickness", cloth.thickness, {1.0e-4, 0.1, false, "m"});
@@ -150,6 +196,11 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
 
   lattice.origin = reader.vec3("origin", sim::Vec3{0.0}, kMaxCoordinate, "m");
   lattice.plane = reader.choice("plane", "xz", {"xz", "xy"}) == "xz" ? sim::LatticePlane::xz : sim::LatticePlane::xy;
+  cloth.fabric = readFabric(reader, model);
+  if (cloth.fabric && (lattice.columns < 2 || lattice.rows < 2)) {
+    reader.fail("fabric", "a sheet of at least 2 x 2 particles for a fabric (a chain has no area)",
+                reader.raw("fabric"));
+  }
   cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
   cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
   cloth.thickness = reader.number("thickness", cloth.thickness, {1.0e-4, 0.1, false, "m"});

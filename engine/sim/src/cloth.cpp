@@ -1,5 +1,6 @@
 #include "drape/sim/cloth.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -144,6 +145,55 @@ ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
     }
   }
   return rest;
+}
+
+std::vector<Hinge> buildHinges(const ClothRest& rest) {
+  struct Side {
+    ParticleIndex low, high, opposite;
+    bool operator<(const Side& o) const {
+      return low != o.low ? low < o.low : high != o.high ? high < o.high : opposite < o.opposite;
+    }
+  };
+  std::vector<Side> sides;
+  sides.reserve(rest.triangles.size() * 3);
+  for (const glm::uvec3& t : rest.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const ParticleIndex a = t[k], b = t[(k + 1) % 3];
+      sides.push_back({std::min(a, b), std::max(a, b), t[(k + 2) % 3]});
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  // cot of the angle at p between q - p and r - p, and twice the triangle's area
+  const auto cotangent = [](Vec3 p, Vec3 q, Vec3 r, Real& doubleArea) {
+    const Vec3 u = q - p, v = r - p;
+    doubleArea = glm::length(glm::cross(u, v));
+    return glm::dot(u, v) / doubleArea;
+  };
+  std::vector<Hinge> hinges;
+  for (std::size_t i = 0; i < sides.size();) {
+    std::size_t j = i + 1;
+    while (j < sides.size() && sides[j].low == sides[i].low && sides[j].high == sides[i].high) ++j;
+    if (j - i == 2) {
+      const Side& one = sides[i];
+      const Side& other = sides[i + 1];
+      const Vec3 x0 = rest.restPosition(one.low), x1 = rest.restPosition(one.high);
+      const Vec3 x2 = rest.restPosition(one.opposite), x3 = rest.restPosition(other.opposite);
+      Real a0 = 0.0, a1 = 0.0, unused = 0.0;
+      const Real t0 = cotangent(x0, x1, x2, a0), t1 = cotangent(x1, x0, x2, unused);
+      const Real f0 = cotangent(x0, x1, x3, a1), f1 = cotangent(x1, x0, x3, unused);
+      const Real area = 0.5 * (a0 + a1);
+      if (a0 > 0.0 && a1 > 0.0 && std::isfinite(t0 + t1 + f0 + f1) && area > 0.0) {
+        const Real s = 1.0 / std::sqrt(area);
+        // Rounded to single precision, the last is what makes the four sum to exactly 0: C then
+        // does not change when the whole cloth moves, wherever it is.
+        const RestReal k0 = static_cast<RestReal>((t1 + f1) * s), k1 = static_cast<RestReal>((t0 + f0) * s);
+        const RestReal k2 = static_cast<RestReal>(-(t0 + t1) * s);
+        hinges.push_back({{one.low, one.high, one.opposite, other.opposite}, {k0, k1, k2, -(k0 + k1 + k2)}});
+      }
+    }
+    i = j;
+  }
+  return hinges;
 }
 
 }  // namespace drape::sim

@@ -266,6 +266,30 @@ void projectCompliantRange(ParticleState& s, const DistanceConstraint* constrain
     projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
 }
 
+// A fabric's hinges, in order (XPBD on the vector constraint C = sum k_i x_i, which is linear in the
+// positions: dlambda = (-C - alpha~ lambda) / (sum w_i k_i^2 + alpha~), x_i += w_i k_i dlambda, with
+// alpha~ = 1 / (B h^2)).
+void projectHinges(ParticleState& s, const std::vector<Hinge>& hinges, std::vector<Vec3>& lambda, Real alphaTilde) {
+  Vec3* x = s.position.data();
+  const Real* w = s.inverseMass.data();
+  for (std::size_t h = 0; h < hinges.size(); ++h) {
+    const Hinge& hinge = hinges[h];
+    const ParticleIndex a = hinge.v[0], b = hinge.v[1], c = hinge.v[2], d = hinge.v[3];
+    const Real k0 = hinge.k[0], k1 = hinge.k[1], k2 = hinge.k[2], k3 = hinge.k[3];
+    const Real weight = w[a] * k0 * k0 + w[b] * k1 * k1 + w[c] * k2 * k2 + w[d] * k3 * k3;
+    if (weight == 0.0) continue;
+    const Vec3 C = k0 * (x[a] - x[d]) + k1 * (x[b] - x[d]) + k2 * (x[c] - x[d]);
+    const Vec3 delta = (-C - alphaTilde * lambda[h]) / (weight + alphaTilde);
+    lambda[h] += delta;
+    x[a] += (w[a] * k0) * delta;
+    x[b] += (w[b] * k1) * delta;
+    x[c] += (w[c] * k2) * delta;
+    x[d] += (w[d] * k3) * delta;
+  }
+}
+
+Real hingeAlphaTilde(const Cloth& cloth, Real h) { return 1.0 / (cloth.settings.fabric->bendingRigidity * h * h); }
+
 }  // namespace
 
 namespace {
@@ -274,17 +298,19 @@ namespace {
 // before it in the order the cloth lists them, then the tethers. One thread.
 void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
+  const bool xpbd = solver.xpbd || cloth.settings.fabric;
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
     const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
-    if (solver.xpbd) {
+    if (xpbd) {
       projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
                             constraints.size(), material.compliance / (h * h));
     } else {
       projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
     }
   }
+  if (!cloth.rest.hinges.empty()) projectHinges(s, cloth.rest.hinges, scratch.hingeLambda, hingeAlphaTilde(cloth, h));
   if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers, 0, scratch.tethers.particles());
 }
 
@@ -304,20 +330,23 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
                       [&](std::size_t begin, std::size_t end, int) { projectTethers(s, scratch.tethers, begin, end); });
   };
   tethers();
+  const bool xpbd = solver.xpbd || cloth.settings.fabric;
+  // A fabric's hinges on one thread, in order (not yet in batches).
+  if (!cloth.rest.hinges.empty()) projectHinges(s, cloth.rest.hinges, scratch.hingeLambda, hingeAlphaTilde(cloth, h));
   for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
     const std::size_t kindIndex = static_cast<std::size_t>(kind);
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
     const Real alphaTilde = material.compliance / (h * h);
     if (kind == ConstraintKind::stretch) {
-      const Real stiffness = solver.xpbd ? 1.0 : material.stiffness;
+      const Real stiffness = xpbd ? 1.0 : material.stiffness;
       Real* looseLambda = scratch.lambda[kindIndex].data();
       // With the tethers between the line steps both steps are full and the tethers follow each,
       // the last too: they keep the edges beside a pin from being pulled long by the last step.
       const bool between = solver.tethersBetweenSteps;
       scratch.extraLineSteps +=
-          lines::solve(cloth, scratch, stiffness, solver.xpbd, alphaTilde, solver.geometricStiffness, workers,
-                       looseLambda, {between, solver.extraLineSteps, solver.stretchTolerance},
+          lines::solve(cloth, scratch, stiffness, xpbd, alphaTilde, solver.geometricStiffness, workers, looseLambda,
+                       {between, solver.extraLineSteps, solver.stretchTolerance},
                        between ? std::function<void()>(tethers) : nullptr);
       continue;
     }
@@ -325,7 +354,7 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
     Real* lambda = scratch.lambda[kindIndex].data();
     // A batch's constraints (no two share a particle) four at a time where the CPU has AVX.
     const auto body = [&](std::size_t begin, std::size_t end, bool batch) {
-      if (solver.xpbd) {
+      if (xpbd) {
         projectCompliantRange(s, constraints, lambda, begin, end, alphaTilde);
         return;
       }
@@ -356,10 +385,11 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
 
 void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, bool contacts,
                         Workers& workers) {
-  if (solver.xpbd) {
+  if (solver.xpbd || cloth.settings.fabric) {
     for (ConstraintKind kind : kConstraintKinds) {
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
     }
+    scratch.hingeLambda.assign(cloth.rest.hinges.size(), Vec3{0.0});
     if (solver.lines) {
       for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.slots(), 0.0);
     }

@@ -68,6 +68,17 @@ void validateCloth(const ClothSettings& cloth, Model model) {
     require(!pin.position || finite(*pin.position), "pin position must be finite");
   }
   require(finite(cloth.thickness) && cloth.thickness > 0.0, "cloth thickness must be positive");
+  if (cloth.fabric) {
+    const Fabric& f = *cloth.fabric;
+    require(model == Model::position, "a fabric needs the position model");
+    require(!cloth.outline ? cloth.lattice.columns >= 2 && cloth.lattice.rows >= 2 : true,
+            "a fabric needs a sheet, at least 2 x 2 particles");
+    for (Real value : {f.arealDensity, f.bendingRigidity, f.stretchStiffness, f.shearStiffness}) {
+      require(finite(value) && value > 0.0 && std::isfinite(1.0 / value),
+              "fabric density, rigidity and stiffnesses must be positive numbers");
+    }
+    require(cloth.masses.empty(), "a fabric's particles weigh what their area does");
+  }
 }
 
 void validateTearing(const TearSettings& tearing) {
@@ -140,8 +151,22 @@ void sortUnique(std::vector<ParticleIndex>& list) {
   list.erase(std::unique(list.begin(), list.end()), list.end());
 }
 
-Cloth makeCloth(const ClothSettings& settings, Model model) {
+// A fabric's stretch and shear in XPBD's compliances; its bending goes to hinges.
+ClothSettings withFabricMaterials(ClothSettings settings) {
+  if (!settings.fabric) return settings;
+  KindMaterial& stretch = settings.material(ConstraintKind::stretch);
+  KindMaterial& shear = settings.material(ConstraintKind::shear);
+  KindMaterial& bend = settings.material(ConstraintKind::bend);
+  stretch.stiffness = shear.stiffness = 1.0;
+  stretch.compliance = 1.0 / settings.fabric->stretchStiffness;
+  shear.compliance = 1.0 / settings.fabric->shearStiffness;
+  bend = KindMaterial{0.0, 0.0, 0.0};
+  return settings;
+}
+
+Cloth makeCloth(const ClothSettings& given, Model model) {
   Cloth cloth;
+  const ClothSettings settings = withFabricMaterials(given);
   cloth.settings = settings;
   const ConstraintSelection selection{used(settings.material(ConstraintKind::stretch)),
                                       used(settings.material(ConstraintKind::shear)),
@@ -153,7 +178,20 @@ Cloth makeCloth(const ClothSettings& settings, Model model) {
   s.position.resize(n);
   for (std::size_t i = 0; i < n; ++i) s.position[i] = cloth.rest.restPosition(i);
   s.mass.assign(n, toMass(settings.mass / static_cast<Real>(n)));
-  if (settings.outline) {
+  if (settings.fabric) {
+    std::vector<Real> area(n, 0.0);
+    for (const glm::uvec3& t : cloth.rest.triangles) {
+      const Real a =
+          0.5 * glm::length(glm::cross(s.position[t[1]] - s.position[t[0]], s.position[t[2]] - s.position[t[0]]));
+      for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const Real m = settings.fabric->arealDensity * area[i];
+      require(m > 0.0 && std::isfinite(1.0 / m), "every particle of a fabric must lie on a triangle with an area");
+      s.mass[i] = toMass(m);
+    }
+    cloth.rest.hinges = buildHinges(cloth.rest);
+  } else if (settings.outline) {
     // By area: a third of each triangle's area to each of its corners, so the border is lighter.
     std::vector<Real> area(n, 0.0);
     Real total = 0.0;
@@ -372,7 +410,7 @@ MemoryUse World::memoryUse() const {
   MemoryUse m;
   for (const Cloth& cloth : cloths_) {
     m.rest += bytes(cloth.rest.restOffsets) + bytes(cloth.rest.triangles);
-    m.constraints += bytes(cloth.rest.constraints);
+    m.constraints += bytes(cloth.rest.constraints) + bytes(cloth.rest.hinges);
     const ParticleState& s = cloth.state;
     m.state += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) +
                bytes(s.mass) + bytes(s.pinned);
@@ -383,8 +421,9 @@ MemoryUse World::memoryUse() const {
   for (const SolverScratch& s : scratch_) {
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
-                bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.looseStretch) + bytes(s.lineNormal) +
-                bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart);
+                bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.hingeLambda) + bytes(s.looseStretch) +
+                bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) +
+                bytes(s.batchStart);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
       m.lines +=
@@ -870,6 +909,8 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   grow(scratch.sumPosition, n);
   grow(scratch.sumVelocity, n);
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
+  // A fabric bends only across the edges that are still shared.
+  if (cloth.settings.fabric) cloth.rest.hinges = buildHinges(cloth.rest);
   // A tether may not reach across a tear; a torn-off copy of a particle is tied to its piece's pins
   // as the particle was. (Built afresh, as loading a snapshot builds them.)
   buildTethers(c);
@@ -1015,6 +1056,8 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   lastGood_.clear();
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     Cloth& cloth = cloths_[c];
+    cloth.settings = withFabricMaterials(cloth.settings);
+    if (cloth.settings.fabric) cloth.rest.hinges = buildHinges(cloth.rest);  // derived from the rest shape
     settings_.cloths.push_back(cloth.settings);
     ParticleState& s = cloth.state;
     // Inverse masses follow from masses and pins (no finger holds anything now); a pin stands still

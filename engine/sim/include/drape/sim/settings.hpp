@@ -105,6 +105,19 @@ struct ParticleMass {
   Real mass = 1.0;  // kg
 };
 
+// A fabric in physical units (position model). The cloth's mass is then arealDensity times its
+// area, a third of each triangle's to each corner; its stretch and shear constraints resist with
+// the compliance 1 / stiffness (XPBD, whatever solver.xpbd says: on the lattice an axis link's
+// spring constant equals the sheet's stiffness in N/m at any spacing, and likewise the diagonals'
+// for shear); and it bends by hinges (Hinge, cloth.hpp) with the rigidity bendingRigidity instead of
+// the seed's distance constraints two particles apart. The `materials` then only give damping.
+struct Fabric {
+  Real arealDensity = 0.2;      // kg/m^2
+  Real bendingRigidity = 1e-5;  // N m (bending moment per unit width per unit curvature)
+  Real stretchStiffness = 1e4;  // N/m (force per unit width per unit strain)
+  Real shearStiffness = 1e3;    // N/m (force per unit width per unit shear angle)
+};
+
 struct ClothSettings {
   LatticeSpec lattice;
   // A drawn cloth: the outline, filled with a lattice (see outline.hpp), instead of `lattice`.
@@ -116,6 +129,7 @@ struct ClothSettings {
   std::array<KindMaterial, kConstraintKindCount> materials{};
   std::vector<Pin> pins;
   std::vector<ParticleMass> masses;  // lattice only: these particles weigh this much instead
+  std::optional<Fabric> fabric;      // physical units instead of `mass` and the materials' stiffness
 
   KindMaterial& material(ConstraintKind kind) { return materials[static_cast<std::size_t>(kind)]; }
   const KindMaterial& material(ConstraintKind kind) const { return materials[static_cast<std::size_t>(kind)]; }
