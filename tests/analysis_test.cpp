@@ -3,7 +3,10 @@
 
 #include <cmath>
 
+#include "drape/analysis/fabric.hpp"
 #include "drape/analysis/stability.hpp"
+
+#include <numbers>
 
 namespace drape::analysis {
 namespace {
@@ -145,6 +148,37 @@ TEST(Stability, TheForceModelsSpringsBoundTheStepOnAChainAndASheet) {
   // Explicit Euler has no stable step: a step well inside the others' bound still blows up.
   EXPECT_EQ(runForceModel(PositionSystem::chain, sim::Integrator::explicitEuler, 1000.0, 0.004, 400).verdict,
             Stability::diverged);
+}
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+TEST(Elastica, GivesPeircesAngleAtTwiceTheBendingLengthAndTheBeamsDeflectionWhenSlight) {
+  // ASTM D1388 reads the bending length as half the overhang whose chord droops 41.5 degrees.
+  EXPECT_NEAR(elasticaChordAngle(2.0), 41.5 * kDegree, 0.05 * kDegree);
+  // Slight: Euler-Bernoulli's tip deflection q L^4 / (8 B), lambda^3 / 8 of the length.
+  EXPECT_NEAR(std::tan(elasticaChordAngle(0.3)), 0.3 * 0.3 * 0.3 / 8.0, 1e-5);
+  // Inverted; and Peirce's formula beside it, whose c at 41.5 degrees is 0.509 L, 2 % over ASTM's L / 2.
+  EXPECT_NEAR(elasticaBendingLength(0.06, elasticaChordAngle(0.06 / 0.025)), 0.025, 1e-6);
+  EXPECT_NEAR(peirceBendingLength(0.05, 41.5 * kDegree), 0.05 * 0.5093, 1e-5);
+  EXPECT_EQ(elasticaBendingLength(0.05, 89.0 * kDegree), 0.0);  // beyond what the shooting trusts
+}
+
+TEST(Cantilever, ADenimStripDroopsAsTheHeavyElasticaDoesWithinFivePercent) {
+  // Denim (0.324 kg/m^2, 6.4e-5 N m): c = 2.72 cm. A 25 mm strip of about 5 cm overhang at two
+  // spacings, settled; the bending length read from its chord through the exact elastica.
+  CantileverSpec spec;
+  spec.fabric = sim::Fabric{0.324, 6.4e-5, 5.0e4, 150.0};
+  spec.substeps = 40;
+  spec.iterations = 16;
+  for (double spacing : {0.0125, 0.00625}) {
+    spec.spacing = spacing;
+    const CantileverResult r = cantilever(spec);
+    ASSERT_FALSE(r.diverged);
+    EXPECT_NEAR(r.expected, 0.02721, 1e-4);
+    EXPECT_LT(r.tipMotion, 1e-5) << "still moving";
+    EXPECT_NEAR(r.bendingLength / r.expected, 1.0, 0.05) << spacing;
+    EXPECT_GT(r.chordAngle, 35.0 * kDegree);  // a real droop, not a stiff strip
+  }
 }
 
 }  // namespace

@@ -66,12 +66,16 @@ TEST(Hinges, ARolledSheetStoresThePlatesEnergyAlongTheAxesAndNoMoreAcross) {
   for (double degrees : {0.0, 90.0}) {
     EXPECT_NEAR(bendingEnergy(rest, rolled(rest, R, degrees), B) / plate, 39.0 / 40.0, 2e-3) << degrees;
   }
-  // Along the diagonals every cell bends, and across at other angles the lattice's one diagonal a
-  // cell makes it softer: the anisotropy docs/fabric.md reports.
+  // Along the cells' diagonals it is the plate's too; at other angles the lattice's one diagonal a
+  // cell makes it softer or stiffer: the anisotropy docs/fabric.md reports.
   EXPECT_NEAR(bendingEnergy(rest, rolled(rest, R, 45.0), B) / plate, 1.0, 5e-3);
   const double skew = bendingEnergy(rest, rolled(rest, R, 22.5), B) / plate;
   EXPECT_GT(skew, 0.75);
   EXPECT_LT(skew, 0.82);
+  // ... and stiffer the other way: across the diagonals' own direction every hinge of a cell bends.
+  const double against = bendingEnergy(rest, rolled(rest, R, -45.0), B) / plate;
+  EXPECT_GT(against, 2.8);
+  EXPECT_LT(against, 3.0);
   // Quadratic: half the radius, four times the energy.
   EXPECT_NEAR(bendingEnergy(rest, rolled(rest, R / 2, 0.0), B) / bendingEnergy(rest, rolled(rest, R, 0.0), B), 4.0,
               0.01);

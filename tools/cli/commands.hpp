@@ -55,6 +55,12 @@ struct StabilityArguments {
   bool quiet = false;
 };
 
+struct FabricArguments {
+  std::string outDir = "fabric";      // CSV
+  std::optional<std::string> report;  // Markdown report
+  bool quiet = false;
+};
+
 struct StudyArguments {
   SceneArguments input;
   std::optional<std::int64_t> steps;
@@ -89,6 +95,7 @@ int validate(const SceneArguments& arguments);
 int bench(const BenchArguments& arguments);
 int study(const StudyArguments& arguments);
 int stability(const StabilityArguments& arguments);
+int fabric(const FabricArguments& arguments);
 int render(const RenderArguments& arguments);
 int run(const RunArguments& arguments);
 int listScenes();

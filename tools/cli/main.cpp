@@ -122,6 +122,11 @@ int main(int argc, char** argv) {
       "stability", "Map where each force-model integrator is stable (stiffness x dt) against linear theory");
   addReportOptions(stabilityCommand, stabilityArguments.outDir, stabilityArguments.report, stabilityArguments.quiet);
 
+  FabricArguments fabricArguments;
+  CLI::App* fabricCommand = app.add_subcommand(
+      "fabric", "The textile lab: every fabric preset in the Peirce cantilever against the heavy elastica");
+  addReportOptions(fabricCommand, fabricArguments.outDir, fabricArguments.report, fabricArguments.quiet);
+
   StudyArguments studyArguments;
   CLI::App* studyCommand =
       app.add_subcommand("study", "Error against run time over configurations of a scene, and integrator orders");
@@ -201,6 +206,7 @@ int main(int argc, char** argv) {
     if (*replayCommand) return run(replayArguments);
     if (*renderCommand) return render(renderArguments);
     if (*stabilityCommand) return stability(stabilityArguments);
+    if (*fabricCommand) return fabric(fabricArguments);
     if (*studyCommand) return study(studyArguments);
     if (*benchCommand) {
       // --quick shrinks only what was not asked for explicitly.

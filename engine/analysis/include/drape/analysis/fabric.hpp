@@ -1,0 +1,51 @@
+// The virtual textile lab: the engine's fabrics (sim::Fabric) in the tests textile labs run, against
+// closed-form answers.
+#pragma once
+
+#include "drape/sim/settings.hpp"
+
+namespace drape::analysis {
+
+// The heavy elastica: a strip clamped level at one end, bent by its own weight, B theta'' = -q (L - s)
+// cos theta, theta(0) = 0, theta'(L) = 0 (theta below the horizontal, s along the strip). In units of
+// the bending length c = (B / q)^(1/3) it depends on L / c alone. Returns the chord's angle below the
+// horizontal from the clamp to the tip (radians), for overhang / c = `lambda` in 0..4.5 (80 degrees).
+double elasticaChordAngle(double lambda);
+// The bending length c (m) for which a strip overhanging `overhang` (m) has that chord angle (the
+// elastica inverted), or 0 outside the angles lambda 0.05..4.5 gives (0.007..80 degrees).
+double elasticaBendingLength(double overhang, double chordAngle);
+// Peirce's (1930) approximation of the same: c = L (cos(theta / 2) / (8 tan theta))^(1/3). ASTM D1388
+// reads the strip at 41.5 degrees and takes c = L / 2 (the formula gives 0.509 L there).
+double peirceBendingLength(double overhang, double chordAngle);
+// (B / (rho g))^(1/3), m: what a fabric's bending length is.
+double bendingLength(const sim::Fabric& fabric, double gravity = 9.81);
+
+struct CantileverSpec {
+  sim::Fabric fabric;
+  double spacing = 0.00625;  // m, the lattice's
+  double overhang = 0.05;    // m, rounded to a whole number of spacings and a half
+  double width = 0.025;      // m, ASTM D1388's strip, rounded likewise
+  int substeps = 10;
+  int iterations = 4;
+  double settle = 5.0;   // s of simulated time, damped, before it is read
+  double damping = 4.0;  // 1/s (global: it slows the strip, it does not change where it comes to rest)
+};
+
+struct CantileverResult {
+  double overhang = 0.0;       // m, as built
+  double chordAngle = 0.0;     // radians below the horizontal, clamp to tip (the rows' mean)
+  double bendingLength = 0.0;  // m: the elastica's c for that angle
+  double peirce = 0.0;         // m: Peirce's formula's
+  double expected = 0.0;       // m: (B / (rho g))^(1/3)
+  double expectedAngle = 0.0;  // radians: the elastica's angle for the fabric's own c
+  double tipMotion = 0.0;      // m, how far the tip moved in the last frame (is it at rest?)
+  double maxStrain = 0.0;      // the longest stretch link's strain at the end
+  double seconds = 0.0;        // wall-clock time the run took
+  bool diverged = false;
+};
+
+// The strip, lying along +x with its first two columns pinned (the platform, whose edge is halfway
+// between them), left to settle under gravity. The overhang is from that edge to the tip.
+CantileverResult cantilever(const CantileverSpec& spec);
+
+}  // namespace drape::analysis
