@@ -83,6 +83,7 @@ CantileverResult cantilever(const CantileverSpec& spec) {
   settings.solver.substeps = spec.substeps;
   settings.solver.iterations = spec.iterations;
   settings.solver.damping = spec.damping;
+  settings.solver.lines = spec.lines;
   sim::ClothSettings cloth;
   cloth.lattice.columns = free + 2;
   cloth.lattice.rows = across + 1;
@@ -98,11 +99,11 @@ CantileverResult cantilever(const CantileverSpec& spec) {
   sim::World world(settings);
 
   CantileverResult result;
-  // The platform's edge is halfway between the pinned columns: the hinges along column 1 bend
-  // the cells on both sides of it, half of which lies on the platform, so each hinge stands for the
-  // strip within half a spacing of its column, and the free strip starts half a spacing before
-  // column 1. (Measured from column 1 instead, the clamp's hinge would count a whole spacing of
-  // curvature, and the strip droop 20 % too far at 12.5 mm, converging only linearly.)
+  // The platform's edge is halfway between the pinned columns: the bend stencils of column 1 bend
+  // the strip within half a spacing of it on either side, half of which lies on the platform, so
+  // the free strip starts half a spacing before column 1. (Measured from column 1 instead, the
+  // clamp's stencil would count a whole spacing of curvature, and the strip droop 20 % too far at
+  // 12.5 mm, converging only linearly.)
   result.overhang = spec.spacing * (free + 0.5);
   result.expected = bendingLength(spec.fabric, 9.81);
   result.expectedAngle = elasticaChordAngle(result.overhang / result.expected);

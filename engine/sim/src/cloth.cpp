@@ -147,53 +147,90 @@ ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
   return rest;
 }
 
-std::vector<Hinge> buildHinges(const ClothRest& rest) {
-  struct Side {
-    ParticleIndex low, high, opposite;
-    bool operator<(const Side& o) const {
-      return low != o.low ? low < o.low : high != o.high ? high < o.high : opposite < o.opposite;
-    }
-  };
-  std::vector<Side> sides;
-  sides.reserve(rest.triangles.size() * 3);
+Real triangleArea(const ClothRest& rest, const glm::uvec3& t) {
+  const Vec3 a = rest.restPosition(t[0]);
+  return 0.5 * glm::length(glm::cross(rest.restPosition(t[1]) - a, rest.restPosition(t[2]) - a));
+}
+
+std::vector<Real> particleAreas(const ClothRest& rest) {
+  std::vector<Real> area(rest.particleCount(), 0.0);
   for (const glm::uvec3& t : rest.triangles) {
-    for (int k = 0; k < 3; ++k) {
-      const ParticleIndex a = t[k], b = t[(k + 1) % 3];
-      sides.push_back({std::min(a, b), std::max(a, b), t[(k + 2) % 3]});
-    }
+    const Real a = triangleArea(rest, t);
+    for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
   }
-  std::sort(sides.begin(), sides.end());
-  // cot of the angle at p between q - p and r - p, and twice the triangle's area
-  const auto cotangent = [](Vec3 p, Vec3 q, Vec3 r, Real& doubleArea) {
-    const Vec3 u = q - p, v = r - p;
-    doubleArea = glm::length(glm::cross(u, v));
-    return glm::dot(u, v) / doubleArea;
-  };
-  std::vector<Hinge> hinges;
-  for (std::size_t i = 0; i < sides.size();) {
-    std::size_t j = i + 1;
-    while (j < sides.size() && sides[j].low == sides[i].low && sides[j].high == sides[i].high) ++j;
-    if (j - i == 2) {
-      const Side& one = sides[i];
-      const Side& other = sides[i + 1];
-      const Vec3 x0 = rest.restPosition(one.low), x1 = rest.restPosition(one.high);
-      const Vec3 x2 = rest.restPosition(one.opposite), x3 = rest.restPosition(other.opposite);
-      Real a0 = 0.0, a1 = 0.0, unused = 0.0;
-      const Real t0 = cotangent(x0, x1, x2, a0), t1 = cotangent(x1, x0, x2, unused);
-      const Real f0 = cotangent(x0, x1, x3, a1), f1 = cotangent(x1, x0, x3, unused);
-      const Real area = 0.5 * (a0 + a1);
-      if (a0 > 0.0 && a1 > 0.0 && std::isfinite(t0 + t1 + f0 + f1) && area > 0.0) {
-        const Real s = 1.0 / std::sqrt(area);
-        // Rounded to single precision, the last is what makes the four sum to exactly 0: C then
-        // does not change when the whole cloth moves, wherever it is.
-        const RestReal k0 = static_cast<RestReal>((t1 + f1) * s), k1 = static_cast<RestReal>((t0 + f0) * s);
-        const RestReal k2 = static_cast<RestReal>(-(t0 + t1) * s);
-        hinges.push_back({{one.low, one.high, one.opposite, other.opposite}, {k0, k1, k2, -(k0 + k1 + k2)}});
+  return area;
+}
+
+std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
+  const std::size_t n = rest.particleCount();
+  const std::vector<Real> area = particleAreas(rest);
+  // Each particle's stretch links, in the order the cloth lists them (deterministic).
+  std::vector<std::uint32_t> start(n + 1, 0);
+  const std::vector<DistanceConstraint>& links = rest.of(ConstraintKind::stretch);
+  for (const DistanceConstraint& c : links) {
+    ++start[c.a + 1];
+    ++start[c.b + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<ParticleIndex> other(start[n]);
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  for (const DistanceConstraint& c : links) {
+    other[fill[c.a]++] = c.b;
+    other[fill[c.b]++] = c.a;
+  }
+  // By particle, not by the links' order (which planning changes with the thread count).
+  for (std::size_t i = 0; i < n; ++i) std::sort(other.begin() + start[i], other.begin() + start[i + 1]);
+  constexpr Real kOpposite = -0.99;  // cos 172 degrees
+  std::vector<BendStencil> stencils;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(area[i] > 0.0)) continue;
+    const Vec3 x = rest.restPosition(i);
+    BendStencil stencil{};
+    stencil.v.fill(static_cast<ParticleIndex>(i));
+    stencil.k.fill(0.0f);
+    Real coefficient[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+    int used = 1, lines = 0;
+    std::vector<bool> taken(start[i + 1] - start[i], false);
+    for (std::uint32_t p = start[i]; p < start[i + 1] && lines < 2; ++p) {
+      if (taken[p - start[i]]) continue;
+      const Vec3 da = rest.restPosition(other[p]) - x;
+      const Real la = glm::length(da);
+      if (!(la > 0.0)) continue;
+      // The most nearly opposite link not yet taken.
+      std::uint32_t best = 0;
+      Real bestCosine = kOpposite;
+      for (std::uint32_t q = p + 1; q < start[i + 1]; ++q) {
+        if (taken[q - start[i]]) continue;
+        const Vec3 db = rest.restPosition(other[q]) - x;
+        const Real lb = glm::length(db);
+        if (!(lb > 0.0)) continue;
+        const Real cosine = glm::dot(da, db) / (la * lb);
+        if (cosine < bestCosine) {
+          bestCosine = cosine;
+          best = q;
+        }
       }
+      if (best == 0) continue;
+      taken[p - start[i]] = taken[best - start[i]] = true;
+      const Real lb = glm::length(rest.restPosition(other[best]) - x);
+      const Real scale = std::sqrt(area[i]) * 2.0 / (la + lb);
+      stencil.v[used] = other[p];
+      coefficient[used++] = scale / la;
+      stencil.v[used] = other[best];
+      coefficient[used++] = scale / lb;
+      ++lines;
     }
-    i = j;
+    if (lines == 0) continue;
+    // Rounded to single precision, k[0] is what makes them sum to exactly 0.
+    float sum = 0.0f;
+    for (int j = 1; j < 5; ++j) {
+      stencil.k[j] = static_cast<RestReal>(coefficient[j]);
+      sum += stencil.k[j];
+    }
+    stencil.k[0] = -sum;
+    stencils.push_back(stencil);
   }
-  return hinges;
+  return stencils;
 }
 
 }  // namespace drape::sim

@@ -266,29 +266,31 @@ void projectCompliantRange(ParticleState& s, const DistanceConstraint* constrain
     projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
 }
 
-// A fabric's hinges, in order (XPBD on the vector constraint C = sum k_i x_i, which is linear in the
-// positions: dlambda = (-C - alpha~ lambda) / (sum w_i k_i^2 + alpha~), x_i += w_i k_i dlambda, with
-// alpha~ = 1 / (B h^2)).
-void projectHinges(ParticleState& s, const std::vector<Hinge>& hinges, std::vector<Vec3>& lambda, Real alphaTilde) {
+// A fabric's bend stencils, in order (XPBD on the vector constraint C = sum k_j (x_j - x_0), which is
+// linear in the positions: dlambda = (-C - alpha~ lambda) / (sum w_j k_j^2 + alpha~),
+// x_j += w_j k_j dlambda, with alpha~ = 1 / (B h^2)).
+void projectBending(ParticleState& s, const std::vector<BendStencil>& stencils, std::vector<Vec3>& lambda,
+                    Real alphaTilde) {
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
-  for (std::size_t h = 0; h < hinges.size(); ++h) {
-    const Hinge& hinge = hinges[h];
-    const ParticleIndex a = hinge.v[0], b = hinge.v[1], c = hinge.v[2], d = hinge.v[3];
-    const Real k0 = hinge.k[0], k1 = hinge.k[1], k2 = hinge.k[2], k3 = hinge.k[3];
-    const Real weight = w[a] * k0 * k0 + w[b] * k1 * k1 + w[c] * k2 * k2 + w[d] * k3 * k3;
+  for (std::size_t i = 0; i < stencils.size(); ++i) {
+    const BendStencil& b = stencils[i];
+    Real weight = 0.0;
+    Vec3 C{0.0};
+    const Vec3 centre = x[b.v[0]];
+    for (int j = 0; j < 5; ++j) {
+      const Real k = b.k[j];
+      weight += w[b.v[j]] * k * k;
+      if (j > 0) C += k * (x[b.v[j]] - centre);
+    }
     if (weight == 0.0) continue;
-    const Vec3 C = k0 * (x[a] - x[d]) + k1 * (x[b] - x[d]) + k2 * (x[c] - x[d]);
-    const Vec3 delta = (-C - alphaTilde * lambda[h]) / (weight + alphaTilde);
-    lambda[h] += delta;
-    x[a] += (w[a] * k0) * delta;
-    x[b] += (w[b] * k1) * delta;
-    x[c] += (w[c] * k2) * delta;
-    x[d] += (w[d] * k3) * delta;
+    const Vec3 delta = (-C - alphaTilde * lambda[i]) / (weight + alphaTilde);
+    lambda[i] += delta;
+    for (int j = 0; j < 5; ++j) x[b.v[j]] += (w[b.v[j]] * Real(b.k[j])) * delta;
   }
 }
 
-Real hingeAlphaTilde(const Cloth& cloth, Real h) { return 1.0 / (cloth.settings.fabric->bendingRigidity * h * h); }
+Real bendingAlphaTilde(const Cloth& cloth, Real h) { return 1.0 / (cloth.settings.fabric->bendingRigidity * h * h); }
 
 }  // namespace
 
@@ -299,6 +301,9 @@ namespace {
 void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   const bool xpbd = solver.xpbd || cloth.settings.fabric;
+  // A fabric's bending first: the sweep ends with what the eye sees most, the cloth's length.
+  if (!cloth.rest.bending.empty())
+    projectBending(s, cloth.rest.bending, scratch.bendingLambda, bendingAlphaTilde(cloth, h));
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
@@ -310,7 +315,6 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
       projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
     }
   }
-  if (!cloth.rest.hinges.empty()) projectHinges(s, cloth.rest.hinges, scratch.hingeLambda, hingeAlphaTilde(cloth, h));
   if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers, 0, scratch.tethers.particles());
 }
 
@@ -331,8 +335,9 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
   };
   tethers();
   const bool xpbd = solver.xpbd || cloth.settings.fabric;
-  // A fabric's hinges on one thread, in order (not yet in batches).
-  if (!cloth.rest.hinges.empty()) projectHinges(s, cloth.rest.hinges, scratch.hingeLambda, hingeAlphaTilde(cloth, h));
+  // A fabric's bend stencils on one thread, in order (not yet in batches).
+  if (!cloth.rest.bending.empty())
+    projectBending(s, cloth.rest.bending, scratch.bendingLambda, bendingAlphaTilde(cloth, h));
   for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
     const std::size_t kindIndex = static_cast<std::size_t>(kind);
     const KindMaterial& material = cloth.settings.material(kind);
@@ -389,7 +394,7 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
     for (ConstraintKind kind : kConstraintKinds) {
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
     }
-    scratch.hingeLambda.assign(cloth.rest.hinges.size(), Vec3{0.0});
+    scratch.bendingLambda.assign(cloth.rest.bending.size(), Vec3{0.0});
     if (solver.lines) {
       for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.slots(), 0.0);
     }

@@ -151,7 +151,7 @@ void sortUnique(std::vector<ParticleIndex>& list) {
   list.erase(std::unique(list.begin(), list.end()), list.end());
 }
 
-// A fabric's stretch and shear in XPBD's compliances; its bending goes to hinges.
+// A fabric's stretch and shear in XPBD's compliances; its bending goes to bend stencils.
 ClothSettings withFabricMaterials(ClothSettings settings) {
   if (!settings.fabric) return settings;
   KindMaterial& stretch = settings.material(ConstraintKind::stretch);
@@ -179,28 +179,18 @@ Cloth makeCloth(const ClothSettings& given, Model model) {
   for (std::size_t i = 0; i < n; ++i) s.position[i] = cloth.rest.restPosition(i);
   s.mass.assign(n, toMass(settings.mass / static_cast<Real>(n)));
   if (settings.fabric) {
-    std::vector<Real> area(n, 0.0);
-    for (const glm::uvec3& t : cloth.rest.triangles) {
-      const Real a =
-          0.5 * glm::length(glm::cross(s.position[t[1]] - s.position[t[0]], s.position[t[2]] - s.position[t[0]]));
-      for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
-    }
+    const std::vector<Real> area = particleAreas(cloth.rest);
     for (std::size_t i = 0; i < n; ++i) {
       const Real m = settings.fabric->arealDensity * area[i];
       require(m > 0.0 && std::isfinite(1.0 / m), "every particle of a fabric must lie on a triangle with an area");
       s.mass[i] = toMass(m);
     }
-    cloth.rest.hinges = buildHinges(cloth.rest);
+    cloth.rest.bending = buildBendStencils(cloth.rest);
   } else if (settings.outline) {
     // By area: a third of each triangle's area to each of its corners, so the border is lighter.
-    std::vector<Real> area(n, 0.0);
+    const std::vector<Real> area = particleAreas(cloth.rest);
     Real total = 0.0;
-    for (const glm::uvec3& t : cloth.rest.triangles) {
-      const Real a =
-          0.5 * glm::length(glm::cross(s.position[t[1]] - s.position[t[0]], s.position[t[2]] - s.position[t[0]]));
-      for (int k = 0; k < 3; ++k) area[t[k]] += a / 3.0;
-      total += a;
-    }
+    for (const glm::uvec3& t : cloth.rest.triangles) total += triangleArea(cloth.rest, t);
     for (std::size_t i = 0; i < n; ++i) s.mass[i] = toMass(settings.mass * area[i] / total);
   }
   for (const ParticleMass& m : settings.masses) s.mass[cloth.rest.index(m.column, m.row)] = toMass(m.mass);
@@ -410,7 +400,7 @@ MemoryUse World::memoryUse() const {
   MemoryUse m;
   for (const Cloth& cloth : cloths_) {
     m.rest += bytes(cloth.rest.restOffsets) + bytes(cloth.rest.triangles);
-    m.constraints += bytes(cloth.rest.constraints) + bytes(cloth.rest.hinges);
+    m.constraints += bytes(cloth.rest.constraints) + bytes(cloth.rest.bending);
     const ParticleState& s = cloth.state;
     m.state += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) +
                bytes(s.mass) + bytes(s.pinned);
@@ -421,7 +411,7 @@ MemoryUse World::memoryUse() const {
   for (const SolverScratch& s : scratch_) {
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
-                bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.hingeLambda) + bytes(s.looseStretch) +
+                bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.bendingLambda) + bytes(s.looseStretch) +
                 bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) +
                 bytes(s.batchStart);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
@@ -909,8 +899,8 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   grow(scratch.sumPosition, n);
   grow(scratch.sumVelocity, n);
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
-  // A fabric bends only across the edges that are still shared.
-  if (cloth.settings.fabric) cloth.rest.hinges = buildHinges(cloth.rest);
+  // A fabric bends only along the stretch lines that still join it.
+  if (cloth.settings.fabric) cloth.rest.bending = buildBendStencils(cloth.rest);
   // A tether may not reach across a tear; a torn-off copy of a particle is tied to its piece's pins
   // as the particle was. (Built afresh, as loading a snapshot builds them.)
   buildTethers(c);
@@ -1057,7 +1047,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     Cloth& cloth = cloths_[c];
     cloth.settings = withFabricMaterials(cloth.settings);
-    if (cloth.settings.fabric) cloth.rest.hinges = buildHinges(cloth.rest);  // derived from the rest shape
+    if (cloth.settings.fabric) cloth.rest.bending = buildBendStencils(cloth.rest);  // derived from the rest shape
     settings_.cloths.push_back(cloth.settings);
     ParticleState& s = cloth.state;
     // Inverse masses follow from masses and pins (no finger holds anything now); a pin stands still

@@ -27,6 +27,7 @@ struct CantileverSpec {
   double width = 0.025;      // m, ASTM D1388's strip, rounded likewise
   int substeps = 10;
   int iterations = 4;
+  bool lines = false;    // the stretch links a line at a time (sim::SolverSettings::lines), not one by one
   double settle = 5.0;   // s of simulated time, damped, before it is read
   double damping = 4.0;  // 1/s (global: it slows the strip, it does not change where it comes to rest)
 };

@@ -53,18 +53,19 @@ struct LatticeSpec {
   LatticePlane plane = LatticePlane::xz;
 };
 
-// Bending between the two triangles beside an interior edge, for a fabric (ClothSettings::fabric):
-// the isometric quadratic bending of Bergou, Wardetzky, Harmon, Zorin and Grinspun (2006). Corners
-// v[0], v[1] are the edge's, v[2] and v[3] the triangles' other corners. With the cotangents of the
-// triangles' angles at the edge (t0, t1 in triangle v0 v1 v2 at v0 and v1; f0, f1 in v0 v1 v3),
-//   K = (cot t1 + cot f1, cot t0 + cot f0, -(cot t0 + cot t1), -(cot f0 + cot f1)) / sqrt(A0 + A1)
-// and C = sum_i k_i x_i (a vector, 0 while the hinge is flat, about |e| theta / sqrt(A0 + A1) when
-// folded by theta), the hinge stores E = B / 2 |C|^2 (B the bending rigidity, N m). A sheet curved
-// to radius R along the lattice's axes then stores B / (2 R^2) per square metre, the plate's energy,
-// exactly; along other directions the lattice's triangles make it 0.79 to 1.0 of that.
-struct Hinge {
-  std::array<ParticleIndex, 4> v;
-  std::array<RestReal, 4> k;  // 1/m; k[3] = -(k[0] + k[1] + k[2]): C = sum_{i<3} k_i (x_i - x_3)
+// A fabric's bending at one particle (ClothSettings::fabric): the discrete Laplacian of the
+// positions along the stretch lines through it, C = sqrt(A) sum over lines of the curve's curvature
+// vector there, 2 / (la + lb) ((x_a - x) / la + (x_b - x) / lb) for the line's neighbours a and b at
+// rest distances la and lb, where A is the particle's share of the area (a third of its triangles').
+// C is linear in the positions and 0 while the sheet is flat; the stencil stores E = B / 2 |C|^2 (B
+// the bending rigidity, N m). Inside a sheet both lines count, so E is B / 2 (k1 + k2)^2 A: for a
+// sheet that does not stretch (k1 k2 = 0) the plate's energy, whichever way it bends (Bergou,
+// Wardetzky, Harmon, Zorin and Grinspun 2006, on the lattice's Laplacian). Along a border only the
+// border's line counts: a free edge carries no moment across itself. v[0] is the particle itself,
+// with k[0] = -(k[1] + ... + k[4]); an unused entry is v[0] again with k 0.
+struct BendStencil {
+  std::array<ParticleIndex, 5> v;
+  std::array<RestReal, 5> k;  // 1/m; C = sum_{j>0} k_j (x_j - x_0)
 };
 
 struct ClothRest {
@@ -78,7 +79,7 @@ struct ClothRest {
   std::vector<glm::vec3> restOffsets;  // m from restOrigin, index = row * columns + column
   std::vector<glm::uvec3> triangles;   // counter-clockwise seen from the front (+y or +z)
   std::array<std::vector<DistanceConstraint>, kConstraintKindCount> constraints;  // by kind
-  std::vector<Hinge> hinges;  // a fabric's bending (buildHinges); empty otherwise
+  std::vector<BendStencil> bending;  // a fabric's (buildBendStencils); empty otherwise
 
   std::size_t particleCount() const { return restOffsets.size(); }
   Vec3 restPosition(std::size_t i) const { return restOrigin + Vec3(restOffsets[i]); }  // m
@@ -100,9 +101,15 @@ struct ConstraintSelection {
   bool bend = true;
 };
 
-// Every interior edge's hinge (an edge two triangles share, flat at rest), from the triangles and
-// rest positions. Edges of one triangle (the border, a tear's seam) or of three or more get none.
-std::vector<Hinge> buildHinges(const ClothRest& rest);
+// A triangle's area at rest, and each particle's share of the area: a third of each of its triangles'.
+Real triangleArea(const ClothRest& rest, const glm::uvec3& triangle);
+std::vector<Real> particleAreas(const ClothRest& rest);
+
+// Every particle's bend stencil, from the stretch constraints (their rest lengths) and the
+// triangles (the areas): a line through a particle is two of its stretch links that point opposite
+// ways at rest (within 8 degrees), at most two lines a particle. A particle on no line (a corner, a
+// tear's tip) gets none.
+std::vector<BendStencil> buildBendStencils(const ClothRest& rest);
 
 // Builds the lattice. Throws std::invalid_argument if the spec is not a valid lattice.
 ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection = {});

@@ -109,7 +109,7 @@ struct ParticleMass {
 // area, a third of each triangle's to each corner; its stretch and shear constraints resist with
 // the compliance 1 / stiffness (XPBD, whatever solver.xpbd says: on the lattice an axis link's
 // spring constant equals the sheet's stiffness in N/m at any spacing, and likewise the diagonals'
-// for shear); and it bends by hinges (Hinge, cloth.hpp) with the rigidity bendingRigidity instead of
+// for shear); and it bends by stencils (BendStencil, cloth.hpp) with the rigidity bendingRigidity instead of
 // the seed's distance constraints two particles apart. The `materials` then only give damping.
 struct Fabric {
   Real arealDensity = 0.2;      // kg/m^2

@@ -43,7 +43,7 @@ struct SolverScratch {
   std::vector<Real> contactDepth;   // m, penetration resolved this substep (for friction)
   // XPBD: the Lagrange multiplier of every constraint, by kind, reset each substep.
   std::array<std::vector<Real>, kConstraintKindCount> lambda;
-  std::vector<Vec3> hingeLambda;  // a fabric's hinges (XPBD, a vector multiplier each), reset each substep
+  std::vector<Vec3> bendingLambda;  // a fabric's bend stencils (XPBD, a vector multiplier each), reset each substep
   // Tethers (solver.tethers): each free particle may be no farther from each of its pins (the nearest of its piece,
   // tethers.hpp) than at rest. Kept in runs of consecutive particles tied to the same pins: a run lists its pins once
   // and each of its particles only its lengths (on hang2 that is 8 bytes a particle, not 24).
