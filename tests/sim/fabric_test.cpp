@@ -90,13 +90,18 @@ TEST(BendStencils, ARolledSheetStoresThePlatesEnergyWhicheverWayItIsRolled) {
   EXPECT_LT(bendingEnergy(rest, twisted, B), 1e-15);
 }
 
-TEST(Fabric, WeighsItsAreaAndBendsByStencilsInsteadOfTheSeedsLinks) {
+// A world of one lying fabric lattice.
+WorldSettings fabricSheet(int columns, int rows, Real width, Real height, Fabric fabric = {}) {
   WorldSettings settings;
   ClothSettings cloth;
-  cloth.lattice = {5, 4, 0.4, 0.3, Vec3{0.0}, LatticePlane::xz};
-  cloth.fabric = Fabric{0.25, 3e-5, 2e4, 100.0};
+  cloth.lattice = {columns, rows, width, height, Vec3{0.0}, LatticePlane::xz};
+  cloth.fabric = fabric;
   settings.cloths.push_back(cloth);
-  const World world(settings);
+  return settings;
+}
+
+TEST(Fabric, WeighsItsAreaAndBendsByStencilsInsteadOfTheSeedsLinks) {
+  const World world(fabricSheet(5, 4, 0.4, 0.3, Fabric{0.25, 3e-5, 2e4, 100.0}));
   const Cloth& c = world.cloths()[0];
   double total = 0.0;
   for (MassReal m : c.state.mass) total += m;
@@ -111,11 +116,7 @@ TEST(Fabric, WeighsItsAreaAndBendsByStencilsInsteadOfTheSeedsLinks) {
 }
 
 TEST(Fabric, IsRefusedWhereItCannotMeanAnything) {
-  WorldSettings settings;
-  ClothSettings cloth;
-  cloth.lattice = {5, 1, 0.4, 0.0, Vec3{0.0}, LatticePlane::xz};
-  cloth.fabric = Fabric{};
-  settings.cloths.push_back(cloth);
+  WorldSettings settings = fabricSheet(5, 1, 0.4, 0.0);
   EXPECT_THROW(World{settings}, std::invalid_argument);  // a chain has no area
   settings.cloths[0].lattice.rows = 3;
   settings.cloths[0].lattice.height = 0.2;
@@ -129,12 +130,7 @@ TEST(Fabric, IsRefusedWhereItCannotMeanAnything) {
 }
 
 TEST(Fabric, ACutFabricBendsOnlyAlongTheLinesThatStillJoinIt) {
-  WorldSettings settings;
-  ClothSettings cloth;
-  cloth.lattice = {9, 9, 0.2, 0.2, Vec3{0.0}, LatticePlane::xz};
-  cloth.fabric = Fabric{};
-  settings.cloths.push_back(cloth);
-  World world(settings);
+  World world(fabricSheet(9, 9, 0.2, 0.2));
   const std::size_t before = world.cloths()[0].rest.bending.size();
   ASSERT_EQ(world.cut(Vec3{0.1, 1.0, -0.1}, Vec3{0.1, 1.0, 0.3}, Vec3{0.0, -2.0, 0.0}), 1);
   const Cloth& c = world.cloths()[0];

@@ -22,6 +22,15 @@ int badInput(const std::string& message) {
   return kExitBadInput;
 }
 
+std::filesystem::path outputFolder(const std::string& outDir) {
+  const std::filesystem::path directory = outDir;
+  std::error_code error;
+  std::filesystem::create_directories(directory, error);
+  if (!std::filesystem::is_directory(directory, error))
+    throw scene::InputError(outDir + ": cannot create the folder for --out-dir");
+  return directory;
+}
+
 scene::Scene loadScene(const SceneArguments& arguments) {
   return scene::loadScene(scene::resolveScenePath(arguments.scene), arguments.overrides);
 }

@@ -18,6 +18,9 @@ namespace drape::cli {
 // Prints "drape-cli: error: MESSAGE" and returns kExitBadInput.
 int badInput(const std::string& message);
 
+// The --out-dir folder, made if it is not there. Throws scene::InputError naming it if it cannot be.
+std::filesystem::path outputFolder(const std::string& outDir);
+
 scene::Scene loadScene(const SceneArguments& arguments);
 
 // The engine validates too; its messages are a last line of defence behind the scene reader's.

@@ -28,11 +28,7 @@ constexpr Setting kSettings[] = {{10, 2, false}, {10, 16, false}, {40, 16, false
 int fabric(const FabricArguments& arguments) {
   try {
     namespace fs = std::filesystem;
-    const fs::path directory = arguments.outDir;
-    std::error_code error;
-    fs::create_directories(directory, error);
-    if (!fs::is_directory(directory, error))
-      throw scene::InputError(arguments.outDir + ": cannot create the folder for --out-dir");
+    const fs::path directory = outputFolder(arguments.outDir);
     const double degree = 180.0 / std::numbers::pi;
     std::ostringstream csv, report;
     csv << "fabric,spacing_m,substeps,iterations,stretch_solver,overhang_m,chord_deg,elastica_deg,bending_length_m,"

@@ -126,11 +126,7 @@ int render(const RenderArguments& arguments) {
     std::vector<std::string> written;
     if (arguments.outDir) {
       // A sequence keeps one camera, framed on the first frame, so the cloth moves and not the view.
-      std::error_code error;
-      std::filesystem::create_directories(*arguments.outDir, error);
-      if (!std::filesystem::is_directory(*arguments.outDir, error)) {
-        throw scene::InputError(*arguments.outDir + ": cannot create the folder for --out-dir");
-      }
+      outputFolder(*arguments.outDir);
       const render::Camera camera = makeCamera(arguments.camera, world, aspect);
       // Every frame or none: a run that diverges halfway leaves the folder as it was.
       scene::OutputBatch frames;

@@ -73,11 +73,7 @@ std::string plotScript() {
 int stability(const StabilityArguments& arguments) {
   try {
     namespace fs = std::filesystem;
-    const fs::path directory = arguments.outDir;
-    std::error_code error;
-    fs::create_directories(directory, error);
-    if (!fs::is_directory(directory, error))
-      throw scene::InputError(arguments.outDir + ": cannot create the folder for --out-dir");
+    const fs::path directory = outputFolder(arguments.outDir);
 
     std::ostringstream map, boundaries, report;
     map << "integrator,stiffness,dt,omega_dt,verdict,max_energy_ratio,end_energy_ratio\n";

@@ -122,11 +122,7 @@ int study(const StudyArguments& arguments) {
     if (base.world.solver.model != sim::Model::position && arguments.sweeps.empty()) {
       throw scene::InputError(base.source + ": study refines substeps and iterations; give --sweep values to compare");
     }
-    const fs::path directory = arguments.outDir;
-    std::error_code error;
-    fs::create_directories(directory, error);
-    if (!fs::is_directory(directory, error))
-      throw scene::InputError(arguments.outDir + ": cannot create the folder for --out-dir");
+    const fs::path directory = outputFolder(arguments.outDir);
 
     // The reference: 8x the substeps and 4x the iterations; refining once more (16x, 8x) shows
     // how far the reference itself is from converged.
