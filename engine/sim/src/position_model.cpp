@@ -296,8 +296,8 @@ Real bendingAlphaTilde(const Cloth& cloth, Real h) { return 1.0 / (cloth.setting
 
 namespace {
 
-// The seed's sweep: every kind in order (stretch, shear, bend), each constraint after the one
-// before it in the order the cloth lists them, then the tethers. One thread.
+// The seed's sweep: a fabric's bend stencils, then every kind in order (stretch, shear, bend), each
+// constraint after the one before it in the order the cloth lists them, then the tethers. One thread.
 void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   const bool xpbd = solver.xpbd || cloth.settings.fabric;

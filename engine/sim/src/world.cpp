@@ -71,8 +71,10 @@ void validateCloth(const ClothSettings& cloth, Model model) {
   if (cloth.fabric) {
     const Fabric& f = *cloth.fabric;
     require(model == Model::position, "a fabric needs the position model");
-    require(!cloth.outline ? cloth.lattice.columns >= 2 && cloth.lattice.rows >= 2 : true,
-            "a fabric needs a sheet, at least 2 x 2 particles");
+    if (!cloth.outline) {
+      require(cloth.lattice.columns >= 2 && cloth.lattice.rows >= 2,
+              "a fabric needs a sheet, at least 2 x 2 particles");
+    }
     for (Real value : {f.arealDensity, f.bendingRigidity, f.stretchStiffness, f.shearStiffness}) {
       require(finite(value) && value > 0.0 && std::isfinite(1.0 / value),
               "fabric density, rigidity and stiffnesses must be positive numbers");
