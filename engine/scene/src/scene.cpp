@@ -100,7 +100,7 @@ std::optional<sim::Fabric> readFabric(ObjectReader& cloth, Model model) {
     return named(*value, cloth.pathOf("fabric"));
   }
   ObjectReader reader = cloth.object("fabric");
-  sim::Fabric fabric = *fabricPreset("cotton");
+  sim::Fabric fabric;  // cotton
   if (reader.has("preset")) {
     fabric = named(*reader.raw("preset"), reader.pathOf("preset"));
     (void)reader.text("preset", "");

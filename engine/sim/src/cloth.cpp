@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -182,6 +183,7 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
   for (std::size_t i = 0; i < n; ++i) std::sort(other.begin() + start[i], other.begin() + start[i + 1]);
   constexpr Real kOpposite = -0.99;  // cos 172 degrees
   std::vector<BendStencil> stencils;
+  std::vector<bool> taken;  // of the particle's links, those on a line already
   for (std::size_t i = 0; i < n; ++i) {
     if (!(area[i] > 0.0)) continue;
     const Vec3 x = rest.restPosition(i);
@@ -190,14 +192,14 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
     stencil.k.fill(0.0f);
     Real coefficient[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
     int used = 1, lines = 0;
-    std::vector<bool> taken(start[i + 1] - start[i], false);
+    taken.assign(start[i + 1] - start[i], false);
     for (std::uint32_t p = start[i]; p < start[i + 1] && lines < 2; ++p) {
       if (taken[p - start[i]]) continue;
       const Vec3 da = rest.restPosition(other[p]) - x;
       const Real la = glm::length(da);
       if (!(la > 0.0)) continue;
       // The most nearly opposite link not yet taken.
-      std::uint32_t best = 0;
+      std::optional<std::uint32_t> found;
       Real bestCosine = kOpposite;
       for (std::uint32_t q = p + 1; q < start[i + 1]; ++q) {
         if (taken[q - start[i]]) continue;
@@ -207,10 +209,11 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
         const Real cosine = glm::dot(da, db) / (la * lb);
         if (cosine < bestCosine) {
           bestCosine = cosine;
-          best = q;
+          found = q;
         }
       }
-      if (best == 0) continue;
+      if (!found) continue;
+      const std::uint32_t best = *found;
       taken[p - start[i]] = taken[best - start[i]] = true;
       const Real lb = glm::length(rest.restPosition(other[best]) - x);
       const Real scale = std::sqrt(area[i]) * 2.0 / (la + lb);

@@ -111,11 +111,12 @@ struct ParticleMass {
 // spring constant equals the sheet's stiffness in N/m at any spacing, and likewise the diagonals'
 // for shear); and it bends by stencils (BendStencil, cloth.hpp) with the rigidity bendingRigidity instead of
 // the seed's distance constraints two particles apart. The `materials` then only give damping.
+// The defaults are the scene layer's "cotton" preset (drape/scene/fabric.hpp).
 struct Fabric {
   Real arealDensity = 0.2;      // kg/m^2
-  Real bendingRigidity = 1e-5;  // N m (bending moment per unit width per unit curvature)
-  Real stretchStiffness = 1e4;  // N/m (force per unit width per unit strain)
-  Real shearStiffness = 1e3;    // N/m (force per unit width per unit shear angle)
+  Real bendingRigidity = 3e-5;  // N m (bending moment per unit width per unit curvature)
+  Real stretchStiffness = 2e4;  // N/m (force per unit width per unit strain)
+  Real shearStiffness = 100.0;  // N/m (force per unit width per unit shear angle)
 };
 
 struct ClothSettings {
