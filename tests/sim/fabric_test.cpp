@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "bending.hpp"
 #include "drape/sim/world.hpp"
 
 namespace drape::sim {
@@ -140,6 +141,83 @@ TEST(Fabric, ACutFabricBendsOnlyAlongTheLinesThatStillJoinIt) {
     for (int k = 1; k < 5; ++k) EXPECT_EQ(c.pieceOf(b.v[k]), c.pieceOf(b.v[0]));
   }
   EXPECT_EQ(world.run(30), StepStatus::ok);
+}
+
+// A sheet bent about at random (a fixed sequence), a few particles pinned and the masses uneven.
+ParticleState bentState(const ClothRest& rest) {
+  ParticleState s;
+  std::uint32_t seed = 12345;
+  const auto next = [&] {
+    seed = seed * 1664525u + 1013904223u;
+    return static_cast<double>(seed >> 8) / static_cast<double>(1u << 24) - 0.5;
+  };
+  for (std::size_t i = 0; i < rest.particleCount(); ++i) {
+    s.position.push_back(rest.restPosition(i) + 0.02 * Vec3{next(), next(), next()});
+    s.inverseMass.push_back(i % 7 == 0 ? 0.0 : 50.0 * (1.0 + next()));
+  }
+  return s;
+}
+
+// The largest |C_i + alpha~ lambda_i| over the stencils: 0 where XPBD's equations all hold.
+double residual(const ClothRest& rest, const ParticleState& s, const std::vector<Vec3>& lambda, double alphaTilde) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < rest.bending.size(); ++i) {
+    const BendStencil& b = rest.bending[i];
+    Vec3 c{0.0};
+    for (int j = 1; j < 5; ++j) c += double(b.k[j]) * (s.position[b.v[j]] - s.position[b.v[0]]);
+    worst = std::max(worst, glm::length(c + alphaTilde * lambda[i]));
+  }
+  return worst;
+}
+
+TEST(BendingBlock, OneProjectionMeetsEveryStencilsEquationAndLeavesPinsWhereTheyAre) {
+  const ClothRest rest = flatSheet(13);
+  ParticleState s = bentState(rest);
+  const ParticleState before = s;
+  const double alphaTilde = 1.0 / (6.4e-5 * 1e-6);  // denim at h = 1 ms
+  std::vector<Vec3> lambda(rest.bending.size(), Vec3{0.0});
+  const double start = residual(rest, s, lambda, alphaTilde);
+  ASSERT_GT(start, 0.1);  // the bent sheet is far from meeting them
+  BendingFactor factor;
+  ASSERT_TRUE(bending::prepare(factor, rest.bending, s.inverseMass, alphaTilde));
+  EXPECT_LE(factor.band, 2u * 13u + 2u);  // stencils two rows apart share no particle
+  bending::project(factor, s, rest.bending, lambda, alphaTilde);
+  // C is linear, so one exact block step meets C + alpha~ lambda = 0 to rounding.
+  EXPECT_LT(residual(rest, s, lambda, alphaTilde), 1e-9 * start);
+  for (std::size_t i = 0; i < s.position.size(); ++i) {
+    if (s.inverseMass[i] == 0.0) {
+      EXPECT_EQ(s.position[i], before.position[i]) << i;
+    }
+  }
+  // A second projection has nothing left to do.
+  const ParticleState once = s;
+  bending::project(factor, s, rest.bending, lambda, alphaTilde);
+  for (std::size_t i = 0; i < s.position.size(); ++i)
+    EXPECT_NEAR(glm::distance(s.position[i], once.position[i]), 0.0, 1e-12);
+}
+
+TEST(BendingBlock, IsFactoredAgainWhenAParticleIsPinnedAndRefusedWhenTooWide) {
+  const ClothRest rest = flatSheet(13);
+  ParticleState s = bentState(rest);
+  const double alphaTilde = 2.0e3;
+  BendingFactor factor;
+  ASSERT_TRUE(bending::prepare(factor, rest.bending, s.inverseMass, alphaTilde));
+  // A finger takes a particle: the factor must follow, or the held particle would move.
+  const std::size_t held = 6 * 13 + 6;
+  s.inverseMass[held] = 0.0;
+  ASSERT_TRUE(bending::prepare(factor, rest.bending, s.inverseMass, alphaTilde));
+  const Vec3 where = s.position[held];
+  std::vector<Vec3> lambda(rest.bending.size(), Vec3{0.0});
+  const double start = residual(rest, s, lambda, alphaTilde);
+  bending::project(factor, s, rest.bending, lambda, alphaTilde);
+  EXPECT_EQ(s.position[held], where);
+  EXPECT_LT(residual(rest, s, lambda, alphaTilde), 1e-9 * start);
+  // A 101 x 101 sheet: 10,197 stencils of half-bandwidth about 200, 4e8 to factor, over the limit.
+  const ClothRest wide = flatSheet(101);
+  const ParticleState far = bentState(wide);
+  BendingFactor wideFactor;
+  EXPECT_FALSE(bending::prepare(wideFactor, wide.bending, far.inverseMass, alphaTilde));
+  EXPECT_FALSE(wideFactor.usable);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "position_model.hpp"
 
 #include "aerodynamics.hpp"
+#include "bending.hpp"
 #include "contacts.hpp"
 #include "distance_wide.hpp"
 #include "lines.hpp"
@@ -292,6 +293,17 @@ void projectBending(ParticleState& s, const std::vector<BendStencil>& stencils, 
 
 Real bendingAlphaTilde(const Cloth& cloth, Real h) { return 1.0 / (cloth.settings.fabric->bendingRigidity * h * h); }
 
+// A fabric's bend stencils: all at once where their block is narrow enough to factor (bending.hpp),
+// else one after another.
+void bend(Cloth& cloth, Real h, SolverScratch& scratch) {
+  const Real alphaTilde = bendingAlphaTilde(cloth, h);
+  if (scratch.bendingFactor.usable) {
+    bending::project(scratch.bendingFactor, cloth.state, cloth.rest.bending, scratch.bendingLambda, alphaTilde);
+  } else {
+    projectBending(cloth.state, cloth.rest.bending, scratch.bendingLambda, alphaTilde);
+  }
+}
+
 }  // namespace
 
 namespace {
@@ -302,8 +314,7 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
   ParticleState& s = cloth.state;
   const bool xpbd = solver.xpbd || cloth.settings.fabric;
   // A fabric's bending first: the sweep ends with what the eye sees most, the cloth's length.
-  if (!cloth.rest.bending.empty())
-    projectBending(s, cloth.rest.bending, scratch.bendingLambda, bendingAlphaTilde(cloth, h));
+  if (!cloth.rest.bending.empty()) bend(cloth, h, scratch);
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
@@ -335,9 +346,8 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
   };
   tethers();
   const bool xpbd = solver.xpbd || cloth.settings.fabric;
-  // A fabric's bend stencils on one thread, in order (not yet in batches).
-  if (!cloth.rest.bending.empty())
-    projectBending(s, cloth.rest.bending, scratch.bendingLambda, bendingAlphaTilde(cloth, h));
+  // A fabric's bend stencils on one thread (not yet in batches).
+  if (!cloth.rest.bending.empty()) bend(cloth, h, scratch);
   for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
     const std::size_t kindIndex = static_cast<std::size_t>(kind);
     const KindMaterial& material = cloth.settings.material(kind);
@@ -395,6 +405,9 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
     }
     scratch.bendingLambda.assign(cloth.rest.bending.size(), Vec3{0.0});
+    if (!cloth.rest.bending.empty()) {
+      bending::prepare(scratch.bendingFactor, cloth.rest.bending, cloth.state.inverseMass, bendingAlphaTilde(cloth, h));
+    }
     if (solver.lines) {
       for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.slots(), 0.0);
     }

@@ -415,7 +415,8 @@ MemoryUse World::memoryUse() const {
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
                 bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.bendingLambda) + bytes(s.looseStretch) +
                 bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) +
-                bytes(s.batchStart);
+                bytes(s.batchStart) + bytes(s.bendingFactor.stencils) + bytes(s.bendingFactor.inverseMass) +
+                bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
       m.lines +=

@@ -66,6 +66,7 @@ struct LatticeSpec {
 struct BendStencil {
   std::array<ParticleIndex, 5> v;
   std::array<RestReal, 5> k;  // 1/m; C = sum_{j>0} k_j (x_j - x_0)
+  bool operator==(const BendStencil&) const = default;
 };
 
 struct ClothRest {

@@ -28,6 +28,18 @@ MassReal toMass(Real mass);
 
 namespace drape::sim {
 
+// A fabric's bending block factored (bending.hpp): the Cholesky factor of G W G^T + alpha~ I in
+// band storage, and what it was made for.
+struct BendingFactor {
+  std::vector<BendStencil> stencils;  // as they were when factored
+  std::vector<Real> inverseMass;
+  Real alphaTilde = 0.0;
+  bool usable = false;      // false: too wide to factor (the stencils are swept instead)
+  std::size_t band = 0;     // half-bandwidth
+  std::vector<Real> lower;  // row i: columns i - band .. i, band + 1 entries a row
+  std::vector<Vec3> work;   // the right-hand side, then the solution
+};
+
 // Per-cloth working arrays of the solver, sized once when the world is made and only for the
 // stages that need them (empty otherwise).
 struct SolverScratch {
@@ -44,6 +56,7 @@ struct SolverScratch {
   // XPBD: the Lagrange multiplier of every constraint, by kind, reset each substep.
   std::array<std::vector<Real>, kConstraintKindCount> lambda;
   std::vector<Vec3> bendingLambda;  // a fabric's bend stencils (XPBD, a vector multiplier each), reset each substep
+  BendingFactor bendingFactor;      // a fabric's: its stencils solved at once
   // Tethers (solver.tethers): each free particle may be no farther from each of its pins (the nearest of its piece,
   // tethers.hpp) than at rest. Kept in runs of consecutive particles tied to the same pins: a run lists its pins once
   // and each of its particles only its lengths (on hang2 that is 8 bytes a particle, not 24).
