@@ -1,11 +1,15 @@
 #include "panels.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <optional>
+#include <string>
 #include <thread>
 
 #include <imgui.h>
 
+#include "drape/scene/fabric.hpp"
 #include "drape/sim/intersections.hpp"
 #include "drape/sim/metrics.hpp"
 
@@ -212,6 +216,28 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     if (ImGui::Button("undo")) session.undo();
     ImGui::SameLine();
     if (ImGui::Button("screenshot")) panels.wantScreenshot = true;
+    // Every sheet made of a fabric in physical units (docs/fabric.md), or as the scene says.
+    const std::string fabric = session.fabric().empty() ? "as the scene says" : session.fabric();
+    if (ImGui::BeginCombo("fabric", fabric.c_str())) {
+      std::optional<std::optional<std::string>> chosen;
+      if (ImGui::Selectable("as the scene says", session.fabric().empty())) chosen.emplace(std::nullopt);
+      for (const scene::FabricPreset& preset : scene::fabricPresets()) {
+        const std::string name(preset.name);
+        if (ImGui::Selectable(name.c_str(), name == session.fabric())) chosen.emplace(name);
+        if (ImGui::IsItemHovered()) {
+          ImGui::SetTooltip("%.0f g/m^2, bending rigidity %.2g N m, bending length %.1f mm\n%s",
+                            1000.0 * preset.fabric.arealDensity, preset.fabric.bendingRigidity,
+                            1000.0 * std::cbrt(preset.fabric.bendingRigidity / (preset.fabric.arealDensity * 9.81)),
+                            std::string(preset.source).c_str());
+        }
+      }
+      ImGui::EndCombo();
+      if (chosen) {
+        session.setFabric(*chosen);  // a new world: nothing below may use the old one
+        ImGui::End();
+        return toLoad;
+      }
+    }
     char file[256];
     std::snprintf(file, sizeof file, "%s", panels.file.c_str());
     if (ImGui::InputText("file", file, sizeof file)) panels.file = file;

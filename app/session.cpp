@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <nlohmann/json.hpp>
 
 #include "drape/render/renderer.hpp"
 #include "drape/scene/error.hpp"
+#include "drape/scene/fabric.hpp"
 #include "drape/scene/output.hpp"
 #include "drape/scene/snapshot.hpp"
 
@@ -46,6 +48,7 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
   world_ = std::move(world);
   world_->setThreads(threads_);
   path_ = path;
+  fabric_.clear();
   interaction_ = std::make_unique<interact::Interaction>(*world_);
   interaction_->settings().material = scene::drawnClothTemplate(scene_);
   interaction_->beforeCut = [this] { undo_.push_back({Undo::Kind::cut, world_->cloths()}); };
@@ -127,6 +130,37 @@ std::optional<std::string> Session::setModel(sim::Model model, sim::Integrator i
                                              std::to_string(world_->settings().solver.substeps) + " substeps)"
                                        : std::string()) +
            ", from the start";
+  return std::nullopt;
+}
+
+std::optional<std::string> Session::setFabric(const std::optional<std::string>& name) {
+  const render::Camera keep = camera_;
+  if (!name) {
+    if (const std::optional<std::string> failed = load(path_)) return failed;
+    camera_ = keep;
+    status = "fabric: as the scene says, from the start";
+    return std::nullopt;
+  }
+  try {
+    scene::Scene changed = scene::withFabric(scene_, *name);
+    const auto& cloths = changed.world.cloths;
+    if (std::none_of(cloths.begin(), cloths.end(), [](const sim::ClothSettings& c) { return c.fabric.has_value(); })) {
+      status = "not applied: " + scene_.name + " has no sheet to make of " + *name;
+      return status;
+    }
+    auto world = std::make_unique<sim::World>(changed.world);
+    adopt(std::move(changed), std::move(world), path_);
+  } catch (const std::invalid_argument& error) {
+    status = std::string("not applied: ") + error.what();
+    return status;
+  }
+  camera_ = keep;
+  fabric_ = *name;
+  const sim::Fabric f = scene::fabricPreset(*name).value();
+  char numbers[160];
+  std::snprintf(numbers, sizeof numbers, " (%.0f g/m^2, bending %.2g N m), from the start", 1000.0 * f.arealDensity,
+                f.bendingRigidity);
+  status = "fabric: " + *name + numbers;
   return std::nullopt;
 }
 

@@ -49,6 +49,11 @@ class Session {
   // Restarts the scene with another model or integrator (scene::withModel); returns a message when
   // the scene cannot run so.
   std::optional<std::string> setModel(sim::Model model, sim::Integrator integrator);
+  // Restarts the scene with every sheet made of the fabric preset `name` (scene::withFabric), or,
+  // with none, as the scene's file says; returns a message when it cannot run so.
+  std::optional<std::string> setFabric(const std::optional<std::string>& name);
+  // The preset setFabric chose, or empty: the cloths are as the scene says.
+  const std::string& fabric() const { return fabric_; }
   // Applies changed settings (from the panels); returns a message when they are refused.
   std::optional<std::string> tune(const sim::WorldSettings& settings);
 
@@ -88,6 +93,7 @@ class Session {
   render::Camera camera_;
   std::vector<Undo> undo_;
   int threads_ = 1;
+  std::string fabric_;
 };
 
 }  // namespace drape::app

@@ -322,5 +322,54 @@ TEST(Session, AnotherModelRestartsTheSceneWithThatModelsMaterials) {
   EXPECT_EQ(session.world().settings().cloths[0].material(sim::ConstraintKind::stretch).stiffness, 1.0);
 }
 
+TEST(Session, AFabricRestartsEverySheetInPhysicalUnitsAndBackAsTheSceneSays) {
+  Session session("desk");
+  const double seedMass = session.world().settings().cloths[0].mass;
+  ASSERT_FALSE(session.setFabric(std::string("denim"))) << session.status;
+  EXPECT_EQ(session.fabric(), "denim");
+  const sim::ClothSettings& cloth = session.world().settings().cloths[0];
+  ASSERT_TRUE(cloth.fabric);
+  EXPECT_EQ(cloth.fabric->arealDensity, 0.324);
+  EXPECT_EQ(cloth.fabric->bendingRigidity, 6.4e-5);
+  // The mass follows from the area: 0.324 kg/m^2 over the sheet's rest area.
+  double area = 0.0;
+  const sim::Cloth& made = session.world().cloths()[0];
+  for (const glm::uvec3& t : made.rest.triangles) {
+    area += 0.5 * glm::length(glm::cross(made.rest.restPosition(t[1]) - made.rest.restPosition(t[0]),
+                                         made.rest.restPosition(t[2]) - made.rest.restPosition(t[0])));
+  }
+  double mass = 0.0;
+  for (const sim::MassReal m : made.state.mass) mass += m;
+  EXPECT_NEAR(mass, 0.324 * area, 1e-6 * mass);
+  EXPECT_FALSE(made.rest.bending.empty());
+  EXPECT_NE(session.status.find("denim (324 g/m^2"), std::string::npos) << session.status;
+  // What a save keeps says so: the document names the fabric and no longer the seed's mass.
+  const nlohmann::json document = nlohmann::json::parse(session.scene().document);
+  EXPECT_EQ(document["cloths"][0]["fabric"], "denim");
+  EXPECT_FALSE(document["cloths"][0].contains("mass"));
+  for (int step = 0; step < 3; ++step) ASSERT_EQ(session.step(), sim::StepStatus::ok) << session.status;
+  // A drawn cloth is of the same fabric.
+  EXPECT_TRUE(session.interaction().settings().material.fabric);
+  ASSERT_TRUE(session.setFabric(std::string("tweed")));
+  EXPECT_EQ(session.fabric(), "denim");  // refused: nothing changed
+  ASSERT_FALSE(session.setFabric(std::nullopt)) << session.status;
+  EXPECT_TRUE(session.fabric().empty());
+  EXPECT_FALSE(session.world().settings().cloths[0].fabric);
+  EXPECT_EQ(session.world().settings().cloths[0].mass, seedMass);
+}
+
+TEST(Session, AFabricTakesTheForceModelToThePositionModelAndRefusesASceneWithoutASheet) {
+  Session session("desk");
+  ASSERT_FALSE(session.setModel(sim::Model::force, sim::Integrator::rk4)) << session.status;
+  ASSERT_FALSE(session.setFabric(std::string("silk"))) << session.status;
+  EXPECT_EQ(session.world().settings().solver.model, sim::Model::position);
+  EXPECT_TRUE(session.world().settings().cloths[0].fabric);
+  Session chain("chain");
+  const std::optional<std::string> refused = chain.setFabric(std::string("silk"));
+  ASSERT_TRUE(refused);
+  EXPECT_NE(refused->find("no sheet"), std::string::npos) << *refused;
+  EXPECT_TRUE(chain.fabric().empty());
+}
+
 }  // namespace
 }  // namespace drape::app

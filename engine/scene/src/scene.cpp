@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -425,6 +426,33 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
       for (json& cloth : document["cloths"]) {
         for (ConstraintKind kind : sim::kConstraintKinds) cloth.erase(std::string(sim::name(kind)));
       }
+    }
+    changed.document = document.dump(-1, ' ', false, json::error_handler_t::replace);
+  }
+  return changed;
+}
+
+Scene withFabric(const Scene& scene, std::string_view name) {
+  const std::optional<sim::Fabric> fabric = fabricPreset(name);
+  if (!fabric) throw std::invalid_argument("no fabric preset " + std::string(name));
+  Scene changed =
+      scene.world.solver.model == Model::position ? scene : withModel(scene, Model::position, sim::Integrator::verlet);
+  const auto sheet = [](const sim::ClothSettings& cloth) {
+    return cloth.outline || (cloth.lattice.columns >= 2 && cloth.lattice.rows >= 2);
+  };
+  for (sim::ClothSettings& cloth : changed.world.cloths) {
+    if (!sheet(cloth)) continue;
+    cloth.fabric = fabric;
+    cloth.masses.clear();
+  }
+  json document = json::parse(changed.document, nullptr, false);
+  if (document.is_object() && document.contains("cloths") && document["cloths"].is_array()) {
+    json& cloths = document["cloths"];
+    for (std::size_t c = 0; c < cloths.size() && c < changed.world.cloths.size(); ++c) {
+      if (!cloths[c].is_object() || !sheet(changed.world.cloths[c])) continue;
+      for (const char* key : {"mass", "masses"}) cloths[c].erase(key);
+      for (ConstraintKind kind : sim::kConstraintKinds) cloths[c].erase(std::string(sim::name(kind)));
+      cloths[c]["fabric"] = std::string(name);
     }
     changed.document = document.dump(-1, ' ', false, json::error_handler_t::replace);
   }

@@ -49,6 +49,13 @@ sim::ClothSettings drawnClothTemplate(const Scene& scene);
 // that is more than the scene has: a light cloth's springs can need hundreds.
 Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator);
 
+// The scene with every sheet (lattice or outline; not a chain, which cannot bend as a sheet) made of
+// the fabric preset `name` (fabric.hpp), as if its file said "fabric": name: the mass then follows
+// from the area, and the materials and per-particle masses go (the document drops them too). A
+// scene in the force model moves to the position model first (withModel), where fabrics live.
+// Throws std::invalid_argument if there is no such preset.
+Scene withFabric(const Scene& scene, std::string_view name);
+
 // Finds a scene by path, or by name in the shipped scenes folder (`hang` -> assets/scenes/hang.json).
 std::filesystem::path resolveScenePath(const std::string& nameOrPath);
 std::filesystem::path sceneDirectory();
