@@ -65,6 +65,35 @@ TEST(Cantilever, AFineStripWithLinesSettlesWithinTwoPercentAtSixteenSweeps) {
   EXPECT_NEAR(r.bendingLength / r.expected, 1.0, 0.02);
 }
 
+TEST(Cusick, NodesAreTheRisesOfTheEdgeThroughItsMean) {
+  // r = 1 + 0.2 cos(6 theta): six folds, whatever the phase; a circle has none.
+  for (double phase : {0.0, 0.3, 1.0}) {
+    std::vector<double> r(360);
+    for (int k = 0; k < 360; ++k) r[k] = 1.0 + 0.2 * std::cos(6.0 * (k * std::numbers::pi / 180.0 + phase));
+    EXPECT_EQ(nodeCount(r, 5), 6) << phase;
+  }
+  EXPECT_EQ(nodeCount(std::vector<double>(360, 1.0), 5), 0);
+}
+
+TEST(Cusick, ASilkDiscHangsLowerThanADenimOneAndBothComeToRest) {
+  // 12.5 mm, 10 x 4: the lab's coarsest run. DC between the limits (0 hanging straight down, 1 flat),
+  // silk's well below denim's (bending lengths 16.5 and 27.2 mm), folds on both.
+  CusickSpec spec;
+  spec.spacing = 0.0125;
+  spec.fabric = sim::Fabric{0.045, 2.0e-6, 5.0e3, 30.0};
+  const CusickResult silk = cusick(spec);
+  spec.fabric = sim::Fabric{0.324, 6.4e-5, 5.0e4, 150.0};
+  const CusickResult denim = cusick(spec);
+  for (const CusickResult& r : {silk, denim}) {
+    ASSERT_FALSE(r.diverged);
+    EXPECT_GT(r.coefficient, 0.2);
+    EXPECT_LT(r.coefficient, 0.95);
+    EXPECT_GE(r.nodes, 3);
+    EXPECT_LT(r.motion, 1e-5);  // 0.01 mm a frame
+  }
+  EXPECT_LT(silk.coefficient + 0.15, denim.coefficient);
+}
+
 }  // namespace
 }  // namespace drape::analysis
 

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <vector>
+
+#include <glm/geometric.hpp>
 
 #include "drape/sim/world.hpp"
 
@@ -133,6 +137,111 @@ CantileverResult cantilever(const CantileverSpec& spec) {
     const double length = glm::length(c.state.position[link.b] - c.state.position[link.a]);
     result.maxStrain = std::max(result.maxStrain, length / link.restLength - 1.0);
   }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+int nodeCount(const std::vector<double>& radius, int smoothing) {
+  const int n = static_cast<int>(radius.size());
+  if (n < 3) return 0;
+  std::vector<double> smooth(radius.size(), 0.0);
+  for (int i = 0; i < n; ++i) {
+    for (int k = -smoothing; k <= smoothing; ++k) smooth[i] += radius[((i + k) % n + n) % n];
+    smooth[i] /= 2 * smoothing + 1;
+  }
+  double mean = 0.0;
+  for (double r : smooth) mean += r;
+  mean /= n;
+  int rises = 0;
+  for (int i = 0; i < n; ++i) {
+    if (smooth[i] <= mean && smooth[(i + 1) % n] > mean) ++rises;
+  }
+  return rises;
+}
+
+CusickResult cusick(const CusickSpec& spec) {
+  const auto started = std::chrono::steady_clock::now();
+  constexpr double kHeight = 0.5;
+  constexpr int kCorners = 180;
+  sim::WorldSettings settings;
+  settings.solver.dt = 1.0 / 60.0;
+  settings.solver.substeps = spec.substeps;
+  settings.solver.iterations = spec.iterations;
+  settings.solver.damping = spec.damping;
+  settings.solver.lines = spec.lines;
+  sim::ClothSettings cloth;
+  sim::OutlineSpec outline;
+  outline.spacing = spec.spacing;
+  outline.height = kHeight;
+  const double R = 0.5 * spec.diameter, r = 0.5 * spec.support;
+  for (int k = 0; k < kCorners; ++k) {
+    const double t = 2.0 * std::numbers::pi * k / kCorners;
+    outline.points.push_back({R * std::cos(t), R * std::sin(t)});
+  }
+  cloth.outline = outline;
+  cloth.fabric = spec.fabric;
+  settings.cloths.push_back(cloth);
+  sim::World world(settings);
+  // The clamp: every particle within the support's radius, pinned where it lies.
+  world.pressFinger(0, sim::Vec3{0.0, kHeight, 0.0}, r + 1e-9);
+  world.pinFinger(0);
+
+  CusickResult result;
+  result.particles = static_cast<int>(world.cloths()[0].state.position.size());
+  const auto frames = static_cast<std::int64_t>(std::ceil(spec.settle / settings.solver.dt));
+  if (world.run(frames - 1) != sim::StepStatus::ok) {
+    result.diverged = true;
+    return result;
+  }
+  const std::vector<sim::Vec3> before = world.cloths()[0].state.position;
+  result.diverged = world.step() != sim::StepStatus::ok;
+  const sim::Cloth& c = world.cloths()[0];
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    result.motion = std::max(result.motion, glm::length(c.state.position[i] - before[i]));
+  }
+  // The shadow on a grid of 0.5 mm cells: a cell is covered where its centre lies in a triangle
+  // seen from above; its radius goes to the angle's bin (1 degree) of the edge profile.
+  constexpr double kCell = 0.0005;
+  const int half = static_cast<int>(std::ceil((R + 0.01) / kCell));
+  const int side = 2 * half;
+  std::vector<std::uint8_t> covered(static_cast<std::size_t>(side) * side, 0);
+  for (const glm::uvec3& t : c.rest.triangles) {
+    const glm::dvec2 a{c.state.position[t[0]].x, c.state.position[t[0]].z};
+    const glm::dvec2 b{c.state.position[t[1]].x, c.state.position[t[1]].z};
+    const glm::dvec2 d{c.state.position[t[2]].x, c.state.position[t[2]].z};
+    const double area = (b.x - a.x) * (d.y - a.y) - (d.x - a.x) * (b.y - a.y);
+    if (area == 0.0) continue;
+    const auto cell = [&](double v) { return std::clamp(static_cast<int>(std::floor(v / kCell)) + half, 0, side - 1); };
+    const int x0 = cell(std::min({a.x, b.x, d.x})), x1 = cell(std::max({a.x, b.x, d.x}));
+    const int z0 = cell(std::min({a.y, b.y, d.y})), z1 = cell(std::max({a.y, b.y, d.y}));
+    for (int z = z0; z <= z1; ++z) {
+      for (int x = x0; x <= x1; ++x) {
+        const glm::dvec2 p{(x - half + 0.5) * kCell, (z - half + 0.5) * kCell};
+        const auto edge = [](glm::dvec2 u, glm::dvec2 v, glm::dvec2 q) {
+          return (v.x - u.x) * (q.y - u.y) - (q.x - u.x) * (v.y - u.y);
+        };
+        const double e0 = edge(a, b, p), e1 = edge(b, d, p), e2 = edge(d, a, p);
+        const bool inside = area > 0.0 ? (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) : (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0);
+        if (inside) covered[static_cast<std::size_t>(z) * side + x] = 1;
+      }
+    }
+  }
+  std::vector<double> profile(360, 0.0);
+  std::size_t cells = 0;
+  for (int z = 0; z < side; ++z) {
+    for (int x = 0; x < side; ++x) {
+      if (!covered[static_cast<std::size_t>(z) * side + x]) continue;
+      ++cells;
+      const double px = (x - half + 0.5) * kCell, pz = (z - half + 0.5) * kCell;
+      const double angle = std::atan2(pz, px) + std::numbers::pi;
+      const int bin = std::min(359, static_cast<int>(angle / (2.0 * std::numbers::pi) * 360.0));
+      profile[static_cast<std::size_t>(bin)] = std::max(profile[static_cast<std::size_t>(bin)], std::hypot(px, pz));
+    }
+  }
+  result.shadowArea = static_cast<double>(cells) * kCell * kCell;
+  const double disc = std::numbers::pi * R * R, clamp = std::numbers::pi * r * r;
+  result.coefficient = (result.shadowArea - clamp) / (disc - clamp);
+  result.nodes = nodeCount(profile, 5);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

@@ -416,7 +416,7 @@ MemoryUse World::memoryUse() const {
                 bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.bendingLambda) + bytes(s.looseStretch) +
                 bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) +
                 bytes(s.batchStart) + bytes(s.bendingFactor.stencils) + bytes(s.bendingFactor.inverseMass) +
-                bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work);
+                bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work) + bytes(s.bendingFactor.rank);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
       m.lines +=

@@ -2,6 +2,8 @@
 // closed-form answers.
 #pragma once
 
+#include <vector>
+
 #include "drape/sim/settings.hpp"
 
 namespace drape::analysis {
@@ -48,5 +50,41 @@ struct CantileverResult {
 // The strip, lying along +x with its first two columns pinned (the platform, whose edge is halfway
 // between them), left to settle under gravity. The overhang is from that edge to the tip.
 CantileverResult cantilever(const CantileverSpec& spec);
+
+// The Cusick drape test (BS 5058, ISO 9073-9): a disc of fabric clamped between two smaller discs
+// and left to hang. Its drape coefficient is the share of the ring around the support that its
+// shadow still covers, DC = (A_shadow - A_support) / (A_disc - A_support): 1 for a stiff sheet
+// that stays flat, near 0 for one that hangs straight down. Nodes are its folds: how many times the
+// shadow's edge, going round, rises through its mean radius.
+struct CusickSpec {
+  sim::Fabric fabric;
+  double spacing = 0.00625;  // m, the lattice's
+  double diameter = 0.30;    // m, the specimen
+  double support = 0.18;     // m, the clamping discs
+  int substeps = 10;
+  int iterations = 4;
+  bool lines = false;
+  double settle = 5.0;   // s
+  double damping = 4.0;  // 1/s
+};
+
+struct CusickResult {
+  double coefficient = 0.0;  // DC, 0..1
+  int nodes = 0;
+  double shadowArea = 0.0;  // m^2
+  double motion = 0.0;      // m, the most a particle moved in the last frame
+  int particles = 0;
+  double seconds = 0.0;
+  bool diverged = false;
+};
+
+// The disc drawn as an outline (sim::OutlineSpec, a polygon of 180 corners) at 0.5 m, its particles
+// within the support's radius pinned where they lie (the clamp), settled under gravity; the shadow
+// is the mesh's triangles projected onto the table, counted on a grid of 0.5 mm cells.
+CusickResult cusick(const CusickSpec& spec);
+
+// Of a shadow's edge radius sampled at equal angles going round: how many times it rises through
+// its mean (after a moving average over `smoothing` samples either side).
+int nodeCount(const std::vector<double>& radius, int smoothing);
 
 }  // namespace drape::analysis

@@ -34,10 +34,11 @@ struct BendingFactor {
   std::vector<BendStencil> stencils;  // as they were when factored
   std::vector<Real> inverseMass;
   Real alphaTilde = 0.0;
-  bool usable = false;      // false: too wide to factor (the stencils are swept instead)
-  std::size_t band = 0;     // half-bandwidth
-  std::vector<Real> lower;  // row i: columns i - band .. i, band + 1 entries a row
-  std::vector<Vec3> work;   // the right-hand side, then the solution
+  bool usable = false;              // false: too wide to factor (the stencils are swept instead)
+  std::vector<std::uint32_t> rank;  // each stencil's row (reverse Cuthill-McKee order)
+  std::size_t band = 0;             // half-bandwidth
+  std::vector<Real> lower;          // row i: columns i - band .. i, band + 1 entries a row
+  std::vector<Vec3> work;           // the right-hand side, then the solution
 };
 
 // Per-cloth working arrays of the solver, sized once when the world is made and only for the
