@@ -78,16 +78,27 @@ double bendingLength(const sim::Fabric& fabric, double gravity) {
   return std::cbrt(fabric.bendingRigidity / (fabric.arealDensity * gravity));
 }
 
-CantileverResult cantilever(const CantileverSpec& spec) {
-  const auto started = std::chrono::steady_clock::now();
-  const int free = std::max(1, static_cast<int>(std::lround(spec.overhang / spec.spacing - 0.5)));
-  const int across = std::max(1, static_cast<int>(std::lround(spec.width / spec.spacing)));
+namespace {
+
+// A lab run's world: 60 frames a second, the spec's substeps, sweeps, damping and stretch solver.
+template <class Spec>
+sim::WorldSettings labWorld(const Spec& spec) {
   sim::WorldSettings settings;
   settings.solver.dt = 1.0 / 60.0;
   settings.solver.substeps = spec.substeps;
   settings.solver.iterations = spec.iterations;
   settings.solver.damping = spec.damping;
   settings.solver.lines = spec.lines;
+  return settings;
+}
+
+}  // namespace
+
+CantileverResult cantilever(const CantileverSpec& spec) {
+  const auto started = std::chrono::steady_clock::now();
+  const int free = std::max(1, static_cast<int>(std::lround(spec.overhang / spec.spacing - 0.5)));
+  const int across = std::max(1, static_cast<int>(std::lround(spec.width / spec.spacing)));
+  sim::WorldSettings settings = labWorld(spec);
   sim::ClothSettings cloth;
   cloth.lattice.columns = free + 2;
   cloth.lattice.rows = across + 1;
@@ -163,12 +174,7 @@ CusickResult cusick(const CusickSpec& spec) {
   const auto started = std::chrono::steady_clock::now();
   constexpr double kHeight = 0.5;
   constexpr int kCorners = 180;
-  sim::WorldSettings settings;
-  settings.solver.dt = 1.0 / 60.0;
-  settings.solver.substeps = spec.substeps;
-  settings.solver.iterations = spec.iterations;
-  settings.solver.damping = spec.damping;
-  settings.solver.lines = spec.lines;
+  sim::WorldSettings settings = labWorld(spec);
   sim::ClothSettings cloth;
   sim::OutlineSpec outline;
   outline.spacing = spec.spacing;
