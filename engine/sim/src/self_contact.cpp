@@ -350,7 +350,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     boxLower_[i] = below(lower_[i]);
     boxUpper_[i] = above(upper_[i]);
   }
-  const std::uint64_t budget = 16 * static_cast<std::uint64_t>(nt + ne) + (1u << 20);
+  const std::uint64_t budget = 16 * static_cast<std::uint64_t>(nt + ne) + 4096;
   while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, {boxLower_.data() + n, boxUpper_.data() + n, nt},
                    1.0 / cellSize_, budget) ||
          !fillGrid(edgeGrid_.start, edgeGrid_.entries, {boxLower_.data() + n + nt, boxUpper_.data() + n + nt, ne},
