@@ -19,8 +19,16 @@ void InputMapper::report(std::string problem) {
   if (problems_.size() > 100) problems_.erase(problems_.begin());
 }
 
+bool InputMapper::parked(int id) const {
+  return std::any_of(parked_.begin(), parked_.end(), [id](const Parked& p) { return p.id == id; });
+}
+
+double InputMapper::liftPerNotch() const {
+  return std::clamp(options_.wheelLift * camera_.distance, options_.wheelLiftMin, options_.wheelLiftMax);
+}
+
 void InputMapper::liftBy(int id, double& height, double notches) {
-  height = std::max(0.0, height + notches * options_.wheelLift);
+  height = std::max(0.0, height + notches * liftPerNotch());
   interaction_.lift(id, height);
 }
 
@@ -78,12 +86,24 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
       } else if (event.button == 2) {
         drag_ = Drag::pan;
       } else if (event.button == 1 && event.ctrl) {
-        // Lift the parked finger nearest the pointer.
-        const auto nearest = std::min_element(parked_.begin(), parked_.end(), [&](const Parked& a, const Parked& b) {
-          return std::hypot(a.x - event.x, a.y - event.y) < std::hypot(b.x - event.x, b.y - event.y);
-        });
-        if (nearest != parked_.end() &&
-            std::hypot(nearest->x - event.x, nearest->y - event.y) <= options_.parkedReach) {
+        // Lift the parked finger whose ring, where it is now in the picture, is nearest the pointer.
+        const std::vector<interact::TouchView> down = interaction_.touches();
+        const double aspect = interaction_.aspect();
+        auto nearest = parked_.end();
+        double best = options_.parkedReach;
+        for (auto p = parked_.begin(); p != parked_.end(); ++p) {
+          const auto view = std::find_if(down.begin(), down.end(), [&](const auto& t) { return t.id == p->id; });
+          if (view == down.end()) continue;
+          const std::optional<glm::dvec2> at = camera_.project(view->position, aspect);
+          if (!at) continue;
+          // In window heights, so the reach is a circle on the screen whatever the aspect.
+          const double apart = std::hypot((at->x - event.x) * aspect, at->y - event.y);
+          if (apart <= best) {
+            best = apart;
+            nearest = p;
+          }
+        }
+        if (nearest != parked_.end()) {
           interaction_.up(nearest->id);
           parked_.erase(nearest);
         }
@@ -114,9 +134,9 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
     case Kind::mouseUp: {
       if (drag_ == Drag::finger && event.button == 1) {
         if (parkOnRelease_) {
-          parked_.push_back({dragFinger_, lastX_, lastY_, dragHeight_});
-        } else {
-          interaction_.up(dragFinger_);
+          parked_.push_back({dragFinger_, dragHeight_});
+        } else if (!interaction_.up(dragFinger_)) {
+          report("mouse: " + interaction_.lastError());
         }
         drag_ = Drag::none;
       } else if ((drag_ == Drag::orbit && event.button == 3) || (drag_ == Drag::pan && event.button == 2)) {
@@ -128,9 +148,11 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
       if (!std::isfinite(event.wheel)) return;
       if (drag_ == Drag::finger) {
         liftBy(dragFinger_, dragHeight_, event.wheel);
+      } else if (uiWantsMouse) {
+        return;  // the panel scrolls
       } else if (!parked_.empty()) {
         liftBy(parked_.back().id, parked_.back().height, event.wheel);
-      } else if (!uiWantsMouse) {
+      } else {
         camera_.zoom(std::pow(options_.zoomPerNotch, event.wheel));
       }
       return;

@@ -4,8 +4,9 @@
 // function of the events and the camera and is tested without a window. Bindings (docs/app.md):
 //   touch          every touch is a sticky finger (or draws, or cuts, in those modes); many at once
 //   left drag      a finger; with Shift held at the press it stays down when the button is released
-//   Ctrl + left    lifts the parked (Shift) finger nearest the pointer
-//   wheel          lifts the finger being dragged, or the last parked one; with none, zooms
+//   Ctrl + left    lifts the parked (Shift) finger whose ring is nearest the pointer
+//   wheel          lifts the finger being dragged, or the last parked one, by a twentieth of the
+//                  camera's distance a notch; with none, zooms; over a panel, scrolls it
 //   right drag     orbits the camera; middle drag pans it
 // A press over a panel (the UI wants the mouse) goes to the panel, not the cloth.
 #pragma once
@@ -35,11 +36,30 @@ struct InputEvent {
 };
 
 struct InputOptions {
-  double wheelLift = 0.02;    // m per wheel notch
-  double orbitSpeed = 4.0;    // rad per window width dragged
-  double zoomPerNotch = 1.1;  // distance divided by this per notch towards the scene
-  double parkedReach = 0.05;  // a Ctrl-click lifts a parked finger this close (window widths)
+  double wheelLift = 0.05;      // camera distances a wheel notch lifts a finger ...
+  double wheelLiftMin = 0.005;  // ... but no less than this (m) ...
+  double wheelLiftMax = 0.25;   // ... nor more (m)
+  double orbitSpeed = 4.0;      // rad per window width dragged
+  double zoomPerNotch = 1.1;    // distance divided by this per notch towards the scene
+  double parkedReach = 0.05;    // a Ctrl-click lifts a parked finger whose ring is this close (window heights)
 };
+
+// A window's rectangle in normalised window coordinates (0..1 from the top left).
+struct ScreenRect {
+  double left = 0.0, top = 0.0, right = 0.0, bottom = 0.0;
+  bool contains(double x, double y) const { return x >= left && x < right && y >= top && y < bottom; }
+};
+
+// Whether a pointer at (x, y) is over one of the panels' windows. The app asks this of the windows
+// as they were drawn last frame, for each event as it comes: not Dear ImGui's WantCaptureMouse, which
+// is decided once a frame and would send a click just after the pointer moved onto a panel (or off
+// it) the wrong way.
+inline bool overAny(const std::vector<ScreenRect>& rects, double x, double y) {
+  for (const ScreenRect& r : rects) {
+    if (r.contains(x, y)) return true;
+  }
+  return false;
+}
 
 class InputMapper {
  public:
@@ -54,6 +74,8 @@ class InputMapper {
     return found == touchIds_.end() ? std::nullopt : std::optional<int>(found->second);
   }
   int parkedFingers() const { return static_cast<int>(parked_.size()); }
+  bool parked(int id) const;    // a Shift-parked mouse finger
+  double liftPerNotch() const;  // m a wheel notch lifts, now
   bool dragging() const { return drag_ != Drag::none; }
   // Events that could not be honoured (an up for a touch that is not down), newest last.
   const std::vector<std::string>& problems() const { return problems_; }
@@ -65,7 +87,6 @@ class InputMapper {
   enum class Drag : std::uint8_t { none, finger, orbit, pan };
   struct Parked {
     int id;
-    double x, y;  // where it was left, in window coordinates
     double height;
   };
 

@@ -56,6 +56,7 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
     if (!undo_.empty() && undo_.back().kind == Undo::Kind::cut) undo_.pop_back();
   };
   interaction_->afterSpawn = [this] { undo_.push_back({Undo::Kind::spawn, {}}); };
+  interaction_->tell = [this](const std::string& line) { status = line; };
   undo_.clear();
   frame();
 }

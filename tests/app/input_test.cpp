@@ -112,18 +112,64 @@ TEST(Input, ShiftParksAFingerCtrlClickLiftsItAndTheWheelRaisesIt) {
   EXPECT_EQ(desk.fingers(), 2u);
   InputEvent wheel;
   wheel.kind = InputEvent::Kind::wheel;
-  wheel.wheel = 5.0;  // 5 notches of 2 cm: the last parked finger rises 10 cm
+  wheel.wheel = 5.0;  // 5 notches of a twentieth of the camera's distance each
   const double distance = desk.session.camera().distance;
   const double pressedAt = desk.session.world().fingers().back().position.y;
+  EXPECT_DOUBLE_EQ(desk.input.liftPerNotch(), 0.05 * distance);
+  desk.input.handle(wheel, true);  // over a panel: the panel scrolls, nothing lifts
   desk.input.handle(wheel, false);
-  for (int i = 0; i < 30; ++i) desk.session.step();
+  for (int i = 0; i < 60; ++i) desk.session.step();
   EXPECT_EQ(desk.session.camera().distance, distance);
-  EXPECT_NEAR(desk.session.world().fingers().back().position.y - pressedAt, 0.1, 1e-9);
+  EXPECT_NEAR(desk.session.world().fingers().back().position.y - pressedAt, 5 * 0.05 * distance, 1e-9);
   desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.46, 0.5, false, true), false);  // Ctrl-click near the first
   EXPECT_EQ(desk.input.parkedFingers(), 1);
   EXPECT_EQ(desk.fingers(), 1u);
   desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.9, 0.9, false, true), false);  // nothing near
   EXPECT_EQ(desk.input.parkedFingers(), 1);
+}
+
+TEST(Input, CtrlClickFindsAParkedFingerByItsRingWhereverTheCameraHasGone) {
+  Desk desk;
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.35, 0.5, true), false);  // off the middle
+  desk.input.handle(mouse(InputEvent::Kind::mouseUp, 1, 0.35, 0.5), false);
+  ASSERT_EQ(desk.input.parkedFingers(), 1);
+  const int id = desk.session.interaction().touches().front().id;
+  EXPECT_TRUE(desk.input.parked(id));
+  // Orbit a quarter turn and more: the ring is no longer where the button was let go.
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 3, 0.5, 0.5), false);
+  desk.input.handle(mouse(InputEvent::Kind::mouseMove, 0, 0.9, 0.5), false);  // 1.6 rad
+  desk.input.handle(mouse(InputEvent::Kind::mouseUp, 3, 0.8, 0.5), false);
+  desk.session.interaction().setCamera(desk.session.camera(), 16.0 / 10.0);
+  const std::optional<glm::dvec2> ring =
+      desk.session.camera().project(desk.session.interaction().touches().front().position, 16.0 / 10.0);
+  ASSERT_TRUE(ring);
+  ASSERT_GT(std::hypot(ring->x - 0.35, ring->y - 0.5), 0.1);
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.35, 0.5, false, true), false);  // where it was let go
+  EXPECT_EQ(desk.input.parkedFingers(), 1);
+  desk.input.handle(mouse(InputEvent::Kind::mouseDown, 1, ring->x + 0.01, ring->y, false, true), false);  // its ring
+  EXPECT_EQ(desk.input.parkedFingers(), 0);
+  EXPECT_EQ(desk.fingers(), 0u);
+}
+
+TEST(Input, APointerIsOverAPanelByTheWindowsRectanglesNotLastFramesGuess) {
+  const std::vector<ScreenRect> panels = {{0.7, 0.0, 1.0, 1.0}, {0.3, 0.3, 0.5, 0.5}};
+  EXPECT_TRUE(overAny(panels, 0.75, 0.5));
+  EXPECT_TRUE(overAny(panels, 0.4, 0.4));
+  EXPECT_FALSE(overAny(panels, 0.6, 0.5));
+  EXPECT_FALSE(overAny(panels, 0.4, 0.6));
+  EXPECT_FALSE(overAny({}, 0.5, 0.5));
+}
+
+TEST(Input, AFailedOutlineDrawnWithTheMouseIsReported) {
+  Session session("empty-table");
+  InputMapper input(session.interaction(), session.camera());
+  session.interaction().setCamera(session.camera(), 16.0 / 10.0);
+  session.interaction().setMode(interact::Mode::create);
+  input.handle(mouse(InputEvent::Kind::mouseDown, 1, 0.5, 0.5), false);  // a click
+  input.handle(mouse(InputEvent::Kind::mouseUp, 1, 0.5, 0.5), false);
+  ASSERT_EQ(input.problems().size(), 1u);
+  EXPECT_EQ(input.problems().back().rfind("mouse: outline: ", 0), 0u) << input.problems().back();
+  EXPECT_EQ(session.status.rfind("no cloth: ", 0), 0u) << session.status;
 }
 
 TEST(Input, RightDragOrbitsAndTheWheelZoomsWhenNoFingerIsDown) {

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -161,6 +163,66 @@ TEST(Interaction, ADrawnClothCanBeTakenBack) {
   EXPECT_FALSE(interaction.up(2));
   EXPECT_EQ(interaction.lastError().rfind("outline: ", 0), 0u) << interaction.lastError();
   EXPECT_TRUE(world.cloths().empty());
+}
+
+TEST(Interaction, ADragTowardsTheHorizonStopsAtThreeCameraDistancesAndMovesOnAsThePointerReturns) {
+  sim::World world(sheet());
+  Interaction interaction(world);
+  const render::Camera camera = obliqueCamera();  // 0.6 rad above the horizon, 2 m away
+  interaction.setCamera(camera, 1.0);
+  ASSERT_TRUE(interaction.down(1, Pointer::onScreen(0.5, 0.5)));
+  const Vec3 pressed = fingerPosition(world, 1);  // on the cloth's surface, its plane's height
+  const Vec3 eye = camera.eye();
+  const Vec3 foot{eye.x, pressed.y, eye.z};
+  // Looking 0.6 rad down with a 0.785 rad view, the horizon lies above the picture, at
+  // y = 0.5 - tan(0.6) / (2 tan(0.39)) = -0.33; the pointer goes up the picture and past it.
+  const double horizon = 0.5 - std::tan(0.6) / (2.0 * std::tan(camera.fieldOfView / 2.0));
+  double farthest = 0.0;
+  for (const double y : {0.3, 0.0, horizon + 0.01, horizon + 0.001, horizon, horizon - 0.001, -2.0}) {
+    ASSERT_TRUE(interaction.move(1, Pointer::onScreen(0.6, y))) << y;
+    interaction.update(1.0 / 60.0);
+    const Vec3 at = fingerPosition(world, 1);
+    EXPECT_NEAR(at.y, pressed.y, 1e-9) << y;  // still in the table plane
+    const double reach = glm::length(at - foot);
+    EXPECT_LE(reach, 3.0 * camera.distance + 1e-6) << y;
+    EXPECT_GE(reach, farthest - 1e-9) << y;  // farther up the picture is never nearer
+    farthest = reach;
+  }
+  EXPECT_NEAR(farthest, 3.0 * camera.distance, 1e-6);  // above the horizon: at the reach
+  // Back down the picture, the finger comes back to where the ray meets the table.
+  ASSERT_TRUE(interaction.move(1, Pointer::onScreen(0.5, 0.5)));
+  interaction.update(1.0 / 60.0);
+  EXPECT_LT(glm::length(fingerPosition(world, 1) - pressed), 1e-9);
+}
+
+TEST(Interaction, ADrawnOutlineSaysWhatItMadeOrWhyItMadeNothing) {
+  sim::WorldSettings settings = sheet();
+  settings.cloths.clear();
+  sim::World world(settings);
+  Interaction interaction(world);
+  std::vector<std::string> told;
+  interaction.tell = [&](const std::string& line) { told.push_back(line); };
+  interaction.settings().spacing = 0.05;
+  interaction.setMode(Mode::create);
+  const auto draw = [&](int id, const std::vector<Vec3>& points) {
+    EXPECT_TRUE(interaction.down(id, Pointer::at(points.front())));
+    for (std::size_t i = 1; i < points.size(); ++i) EXPECT_TRUE(interaction.move(id, Pointer::at(points[i])));
+    return interaction.up(id);
+  };
+  // A 0.4 m square at 5 cm: 9 x 9 particles.
+  EXPECT_TRUE(draw(1, {Vec3{0.0}, Vec3{0.4, 0.0, 0.0}, Vec3{0.4, 0.0, 0.4}, Vec3{0.0, 0.0, 0.4}}));
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told.back(), "a cloth of " + std::to_string(world.cloths().back().state.position.size()) +
+                             " particles, 0.40 m x 0.40 m");
+  // A figure eight: two loops, the larger kept, and said so.
+  EXPECT_TRUE(draw(2, {Vec3{0.0}, Vec3{0.6, 0.0, 0.4}, Vec3{0.6, 0.0, 0.0}, Vec3{0.0, 0.0, 0.2}}));
+  ASSERT_EQ(told.size(), 2u);
+  EXPECT_NE(told.back().find("the largest loop was kept"), std::string::npos) << told.back();
+  // A click draws nothing, and says why.
+  EXPECT_FALSE(draw(3, {Vec3{0.1, 0.0, 0.1}}));
+  ASSERT_EQ(told.size(), 3u);
+  EXPECT_EQ(told.back().rfind("no cloth: ", 0), 0u) << told.back();
+  EXPECT_EQ(world.cloths().size(), 2u);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include <glm/geometric.hpp>
@@ -15,6 +16,10 @@ namespace {
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 const Vec3 kUp{0.0, 1.0, 0.0};
+
+// A screen pointer's finger stays within this many camera distances of the point of its plane
+// under the eye.
+constexpr Real kReach = 3.0;
 
 // Area of the loop in the table plane (x, z).
 Real loopArea(const std::vector<glm::dvec2>& loop) {
@@ -107,12 +112,20 @@ std::optional<Vec3> Interaction::pointOnPlane(const Pointer& pointer, Vec3 ancho
   }
   if (!std::isfinite(pointer.screen.x) || !std::isfinite(pointer.screen.y)) return std::nullopt;
   const render::Ray ray = camera_.ray(pointer.screen.x, pointer.screen.y, aspect_);
+  // The plane's point under the eye, and the ray's heading within the plane.
+  const Vec3 foot = ray.origin - normal * glm::dot(ray.origin - anchor, normal);
+  const Vec3 heading = ray.direction - normal * glm::dot(ray.direction, normal);
+  const Real reach = kReach * camera_.distance;
   const Real facing = glm::dot(ray.direction, normal);
-  // A ray (nearly) along the plane, or meeting it behind the eye, gives no point: the finger stays.
-  if (std::abs(facing) < 1e-6) return std::nullopt;
-  const Real t = glm::dot(anchor - ray.origin, normal) / facing;
-  if (!(t > 0.0) || t > 1.0e4) return std::nullopt;
-  return ray.origin + ray.direction * t;
+  if (std::abs(facing) > 1e-9) {
+    const Real t = glm::dot(anchor - ray.origin, normal) / facing;
+    const Vec3 hit = ray.origin + ray.direction * t;
+    if (t > 0.0 && glm::length(hit - foot) <= reach) return hit;
+  }
+  // Towards the horizon (or above it) a small move of the pointer would carry the finger metres, or
+  // to no point at all: the finger goes no farther than `reach` from the foot, in the ray's heading.
+  if (!(glm::length(heading) > 1e-9)) return std::nullopt;  // straight at the plane along its normal
+  return foot + glm::normalize(heading) * reach;
 }
 
 bool Interaction::down(int id, const Pointer& pointer, std::optional<Real> radius) {
@@ -316,7 +329,20 @@ bool Interaction::spawn(const Touch& touch) {
     cloth.mass = settings_.arealDensity * loopArea(shape.loop);
     spawnedIndex_.push_back(world_.addCloth(cloth));
     if (afterSpawn) afterSpawn();
+    if (tell) {
+      glm::dvec2 lower = shape.loop.front(), upper = shape.loop.front();
+      for (const glm::dvec2& p : shape.loop) {
+        lower = glm::min(lower, p);
+        upper = glm::max(upper, p);
+      }
+      char said[160];
+      std::snprintf(said, sizeof said, "a cloth of %zu particles, %.2f m x %.2f m%s", shape.rest.particleCount(),
+                    upper.x - lower.x, upper.y - lower.y,
+                    shape.tookLargestLoop ? " (the outline crossed itself: the largest loop was kept)" : "");
+      tell(said);
+    }
   } catch (const std::invalid_argument& error) {
+    if (tell) tell(std::string("no cloth: ") + error.what());
     return fail(std::string("outline: ") + error.what());
   }
   return true;

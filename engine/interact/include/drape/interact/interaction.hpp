@@ -8,8 +8,9 @@
 //           for world pointers);
 //   create  its path is an outline; when it lifts, a cloth of that shape appears on the table.
 // A screen pointer moves in the finger's plane: the table plane (horizontal) or the view plane
-// (facing the camera), through the point where the finger went down. World pointers are taken as
-// they are. A finger's height above its plane is set by `lift` (the mouse wheel, say).
+// (facing the camera), through the point where the finger went down; towards the horizon it goes
+// no farther than three camera distances from the plane's point under the eye. World pointers are
+// taken as they are. A finger's height above its plane is set by `lift` (the mouse wheel, say).
 //
 // Events that cannot be honoured (an unknown finger, a second down for one id, a pointer that is
 // not finite) are skipped and explained in lastError(); they never throw.
@@ -94,6 +95,7 @@ class Interaction {
 
   void setCamera(const render::Camera& camera, double aspect);
   const render::Camera& camera() const { return camera_; }
+  double aspect() const { return aspect_; }
   void setMode(Mode mode);
   Mode mode() const { return mode_; }
   void setPlane(FingerPlane plane);
@@ -120,6 +122,9 @@ class Interaction {
   std::function<void()> cutNothing;
   // Called when a drawn cloth has been added to the world.
   std::function<void()> afterSpawn;
+  // Called with a line worth showing the user when a drawn outline lifts: the cloth it made (its
+  // particles and size, and whether a crossing stroke kept only its largest loop), or why none.
+  std::function<void(const std::string&)> tell;
   // Called after every event that took, with world pointers (where the finger went down, moved,
   // drew or cut), so a session can be recorded as a gesture script; the time is the caller's.
   std::function<void(const GestureEvent&)> record;
