@@ -179,6 +179,22 @@ INSTANTIATE_TEST_SUITE_P(Drops, Tunnelling,
                          ::testing::Values(FastDrop{0.5, 0.005}, FastDrop{0.6, 0.01}, FastDrop{0.7, 0.01},
                                            FastDrop{0.55, 0.002}));
 
+// A snapshot the fuzzer made (tests/fuzz/crashers/snapshot/timeout-37fc...): one particle's
+// previous position 5.7e307 m below it. Its motion's length overflows to inf, the march along it
+// met a NaN distance, and its parameter went NaN and never passed 1: the step never ended. Now
+// it ends, and nothing non-finite is left.
+TEST(Tunnelling, AMotionNearTheDoubleRangeEndsTheStepWithNothingNonFinite) {
+  WorldSettings settings = sheetAbove(6, 0.5, 0.6);
+  settings.colliders.push_back(plane({0, 0, 0}, {0, 1, 0}, 0.6));
+  settings.colliders.push_back(sphere({1, 0.2, 0}, 0.2));
+  World world(settings);
+  std::vector<Cloth> cloths = world.cloths();
+  cloths[0].state.previousPosition[7].y = 5.695005249251403e307;
+  world.restoreCloths(std::move(cloths));
+  for (int i = 0; i < 2; ++i) world.step();  // ok (the table stops it) or diverged: both end
+  for (const Vec3& x : world.cloths()[0].state.position) ASSERT_TRUE(std::isfinite(glm::length(x)));
+}
+
 TEST(MovingColliders, ARisingBoardLiftsTheClothInsteadOfPassingThroughIt) {
   // 3 m/s at 2 substeps of 1/120 s: the 1 cm board moves 2.5 cm a substep, farther than it is thick.
   WorldSettings settings = sheetAbove(10, 0.3, 0.4);

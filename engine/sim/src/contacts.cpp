@@ -45,7 +45,9 @@ Candidate touch(const Collider& collider, int index, Vec3 previous, Vec3 to, Rea
   while (travel > 0.0) {
     if (here.distance < thickness) return planeThrough(from + motion * t, here);
     t += std::max(std::max(here.distance - thickness * 0.5, thickness * 0.25) / travel, 1.0 / 256.0);
-    if (t > 1.0) break;
+    // Also ends a march that met a NaN: a motion near the double range (a particle flung 1e307 m)
+    // overflows its length to inf, and the distance at a point of it can be inf - inf.
+    if (!(t <= 1.0)) break;
     here = collider.distance(from + motion * t, reach);
   }
   // The end point itself (the march may step past a surface it only grazes at the end).
