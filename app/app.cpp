@@ -227,7 +227,9 @@ KeyAction keyAction(SDL_Keycode key, bool ctrl) {
     case SDLK_s: return ctrl ? KeyAction::save : KeyAction::none;
     case SDLK_o: return ctrl ? KeyAction::load : KeyAction::none;
     case SDLK_q: return ctrl ? KeyAction::quit : KeyAction::none;
-    case SDLK_ESCAPE: return KeyAction::quit;
+    case SDLK_ESCAPE: return KeyAction::askQuit;
+    case SDLK_f: return KeyAction::frame;
+    case SDLK_HOME: return KeyAction::resetView;
     default: return KeyAction::none;
   }
 }
@@ -363,6 +365,9 @@ int runApp(const AppOptions& options) {
 
     std::int64_t frame = 0;
     bool running = true;
+    std::optional<Clock::time_point> quitAsked;
+    // The first view is framed once the panel's width is known, unless a script brought its camera.
+    bool framed = replay && replay->script().camera.has_value();
     Clock::time_point last = Clock::now();
     while (running) {
       const Clock::time_point now = Clock::now();
@@ -384,6 +389,16 @@ int runApp(const AppOptions& options) {
         if (event.type == SDL_KEYDOWN && !ImGui::GetIO().WantCaptureKeyboard) {
           const KeyAction action = keyAction(event.key.keysym.sym, (event.key.keysym.mod & KMOD_CTRL) != 0);
           if (action == KeyAction::quit) running = false;
+          if (action == KeyAction::askQuit) {
+            // Esc twice within 3 s: one stray press does not throw away drawn cloths and cuts.
+            const Clock::time_point pressed = Clock::now();
+            if (quitAsked && pressed - *quitAsked < std::chrono::seconds(3)) {
+              running = false;
+            } else {
+              quitAsked = pressed;
+              session->status = "press Esc again to quit (Ctrl+S saves first)";
+            }
+          }
           if (action == KeyAction::step) stepOnce = true;
           if (action == KeyAction::screenshot && size.drawable()) panels.wantScreenshot = true;
           applyKey(action, *session, panels);
@@ -391,10 +406,20 @@ int runApp(const AppOptions& options) {
         }
         size = sizeOf(window);
         if (const std::optional<InputEvent> input_event = translate(event, size)) {
-          const bool overUi = ImGui::GetIO().WantCaptureMouse && !touch;
+          // Over a panel as the panels were last drawn, for this event where it is now (the wheel's
+          // own event has no position: the pointer's is taken); touches always reach the cloth.
+          double x = input_event->x, y = input_event->y;
+          if (input_event->kind == InputEvent::Kind::wheel) {
+            int px = 0, py = 0;
+            SDL_GetMouseState(&px, &py);
+            x = size.width > 0 ? static_cast<double>(px) / size.width : 0.0;
+            y = size.height > 0 ? static_cast<double>(py) / size.height : 0.0;
+          }
+          const bool overUi = !touch && (overAny(panels.windows, x, y) || ImGui::IsAnyItemActive());
           input->handle(*input_event, overUi);
         }
       }
+      session->keepCameraAboveTable();
 
       if (replay) replay->afterEvents(*session, *input);
 
@@ -416,7 +441,7 @@ int runApp(const AppOptions& options) {
       if (size.drawable()) {
         render::FrameOptions frameOptions = panels.frameOptions;
         renderer->render(session->world(), session->camera(), size.pixelsWide, size.pixelsHigh, frameOptions,
-                         fingerOverlay(*session));
+                         fingerOverlay(*session, *input));
         renderer->finish();
         const Clock::time_point panelStart = Clock::now();
         stats.sceneSeconds = std::chrono::duration<double>(panelStart - drawStart).count();
@@ -426,6 +451,11 @@ int runApp(const AppOptions& options) {
         const std::optional<std::filesystem::path> toLoad = drawPanels(*session, panels, stats, *input);
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        session->setView(size.aspect(), size.width > 0 ? panels.panelWidth / static_cast<float>(size.width) : 0.0);
+        if (!framed && panels.panelWidth > 0.0f) {
+          session->resetView();  // now that the panel's width is known: the scene beside it
+          framed = true;
+        }
         if (toLoad) session->load(*toLoad);  // on failure the message is in the status line and the scene stays
         remap();                             // a load, reset or model change made a new interaction
         if (options.screenshotAfter && frame + 1 == *options.screenshotAfter && options.screenshotFile) {

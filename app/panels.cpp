@@ -5,7 +5,10 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <fstream>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include <imgui.h>
 
@@ -21,28 +24,73 @@ const char* const kHelp[][2] = {
     {"touch", "a sticky finger (draws in Create mode, cuts in Cut mode); any number at once"},
     {"left drag", "a finger"},
     {"Shift + left drag", "a finger that stays down when the button is released"},
-    {"Ctrl + left click", "lift the parked finger nearest the pointer"},
     {"wheel", "lift (or lower) the finger being dragged, else the last parked; with none, zoom"},
+    {"Ctrl + left click", "lift the parked finger whose ring is nearest"},
     {"right drag / middle drag", "orbit / pan the camera"},
+    {"F / Home", "frame the cloth / the view the scene starts with"},
     {"1 / 2 / 3", "Sticky / Cut / Create mode"},
     {"V", "fingers move in the table plane or the view plane"},
     {"Space / N", "pause / one step while paused"},
-    {"R", "reset the scene"},
+    {"R", "reset the scene (the camera stays)"},
     {"U or Ctrl+Z", "undo the last drawn cloth or cut"},
     {"P or F12", "screenshot (drape-screenshot-NNN.png)"},
     {"Ctrl+S / Ctrl+O", "save / load the file named in the panel"},
     {"Tab / H or F1", "hide the panels / this help"},
-    {"Esc or Ctrl+Q", "quit"},
+    {"Esc twice or Ctrl+Q", "quit"},
 };
 
-std::vector<std::filesystem::path> shippedScenes() {
-  std::vector<std::filesystem::path> files;
+struct ShippedScene {
+  std::filesystem::path file;
+  std::string name;
+  std::string description;  // the file's "description", for the picker's tooltip
+};
+
+std::vector<ShippedScene> shippedScenes() {
+  std::vector<ShippedScene> scenes;
   std::error_code error;
   for (const auto& entry : std::filesystem::directory_iterator(scene::sceneDirectory(), error)) {
-    if (entry.path().extension() == ".json") files.push_back(entry.path());
+    if (entry.path().extension() != ".json") continue;
+    ShippedScene s{entry.path(), entry.path().stem().string(), {}};
+    std::ifstream in(entry.path());
+    const nlohmann::json document = nlohmann::json::parse(in, nullptr, false);
+    if (document.is_object() && document.contains("description") && document["description"].is_string()) {
+      s.description = document["description"].get<std::string>();
+    }
+    scenes.push_back(std::move(s));
   }
-  std::sort(files.begin(), files.end());
-  return files;
+  std::sort(scenes.begin(), scenes.end(), [](const auto& a, const auto& b) { return a.file < b.file; });
+  return scenes;
+}
+
+// A tooltip on the item just drawn, wrapped to a readable width.
+void tip(const char* text) {
+  if (!ImGui::IsItemHovered()) return;
+  ImGui::BeginTooltip();
+  ImGui::PushTextWrapPos(ImGui::GetFontSize() * 28.0f);
+  ImGui::TextUnformatted(text);
+  ImGui::PopTextWrapPos();
+  ImGui::EndTooltip();
+}
+
+// Records the window being drawn (between Begin and End, or inside a combo's popup) as one the
+// pointer can be over.
+void noteWindow(PanelState& panels) {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  if (display.x <= 0.0f || display.y <= 0.0f) return;
+  const ImVec2 at = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  panels.windows.push_back({at.x / display.x, at.y / display.y, (at.x + size.x) / display.x,
+                            (at.y + size.y) / display.y});
+}
+
+const char* modeHint(interact::Mode mode) {
+  switch (mode) {
+    case interact::Mode::sticky:
+      return "Sticky: drag the cloth with the left button or a finger (Shift leaves the finger down, the wheel "
+             "lifts it); right drag orbits";
+    case interact::Mode::cut: return "Cut: swipe across the cloth to cut it along the swipe";
+    case interact::Mode::create: return "Create: draw an outline on the table; a cloth of that shape appears";
+  }
+  return "";
 }
 
 bool sliderReal(const char* label, double& value, double low, double high, const char* format = "%.3f",
@@ -61,11 +109,16 @@ bool vector3(const char* label, sim::Vec3& value, float speed) {
 }
 
 void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(10, 10));
   ImGui::SetNextWindowBgAlpha(0.55f);
+  // No wider than the window leaves beside the panel, and never half of it: long lines wrap.
+  const float room = std::max(120.0f, std::min(display.x * 0.5f, display.x - panels.panelWidth - 30.0f));
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f), ImVec2(room, display.y * 0.6f));
   ImGui::Begin("HUD", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav | ImGuiWindowFlags_NoInputs);
+  ImGui::PushTextWrapPos(room - 16.0f);
   const interact::Interaction& interaction = session.interaction();
   const double fps = stats.frameSeconds > 0.0 ? 1.0 / stats.frameSeconds : 0.0;
   ImGui::Text("%s   %.0f fps   t = %.2f s%s", session.scene().name.c_str(), fps, session.world().time(),
@@ -74,8 +127,10 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
               std::string(interact::name(interaction.settings().plane)).c_str(), session.world().fingers().size());
   ImGui::Text("simulation %.1f ms (%d steps), drawing %.1f ms per frame", stats.simulationSeconds * 1e3, stats.steps,
               stats.drawSeconds * 1e3);
-  ImGui::Text("  drawing: scene %.1f ms, panels %.1f ms, presenting %.1f ms", stats.sceneSeconds * 1e3,
-              stats.panelSeconds * 1e3, stats.swapSeconds * 1e3);
+  if (display.x >= 1000.0f) {  // the detail, where there is room for it
+    ImGui::Text("  drawing: scene %.1f ms, panels %.1f ms, presenting %.1f ms", stats.sceneSeconds * 1e3,
+                stats.panelSeconds * 1e3, stats.swapSeconds * 1e3);
+  }
   if (fps > 0.0 && fps < 55.0) {
     // Say why, in the terms the user can act on.
     const bool simulation = stats.simulationSeconds > stats.drawSeconds;
@@ -85,14 +140,24 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
   }
   if (stats.fellBehind) ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "slower than real time");
   if (!session.status.empty()) ImGui::TextWrapped("%s", session.status.c_str());
-  if (!panels.showHelp) ImGui::TextDisabled("F1: help");
+  // What the mode does, and what is being drawn: the size the cloth would be.
+  ImGui::TextColored(ImVec4(0.7f, 0.9f, 1.0f, 1.0f), "%s", modeHint(interaction.mode()));
+  for (const interact::TouchView& touch : interaction.touches()) {
+    if (touch.mode != interact::Mode::create) continue;
+    const OutlineSize size = outlineSize(touch.stroke, interaction.settings().spacing);
+    ImGui::Text("outline %.2f m x %.2f m: about %.0f particles at %.0f mm", size.width, size.depth, size.particles,
+                1000.0 * interaction.settings().spacing);
+  }
+  ImGui::TextDisabled("1 sticky  2 cut  3 create   F frame   Home view   F1 all keys");
+  ImGui::PopTextWrapPos();
   ImGui::End();
 }
 
-void help() {
+void help(PanelState& panels) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(display.x * 0.5f, display.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
   ImGui::Begin("Help", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings);
+  noteWindow(panels);
   if (ImGui::BeginTable("bindings", 2)) {
     for (const auto& row : kHelp) {
       ImGui::TableNextRow();
@@ -151,9 +216,12 @@ void applyKey(KeyAction action, Session& session, PanelState& panels) {
       break;
     }
     case KeyAction::load: session.load(panels.file); break;
+    case KeyAction::frame: session.frameCloths(); break;
+    case KeyAction::resetView: session.resetView(); break;
+    case KeyAction::step: session.paused = true; break;  // the app takes the step
     case KeyAction::none:
-    case KeyAction::step:
     case KeyAction::screenshot:
+    case KeyAction::askQuit:
     case KeyAction::quit: break;
   }
 }
@@ -182,33 +250,67 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     panels.stages[i].add(static_cast<float>(world.profile()[i].lastSeconds * 1e3));
   }
 
+  panels.windows.clear();
   hud(session, panels, stats);
-  if (panels.showHelp) help();
-  if (!panels.showPanels) return toLoad;
+  if (panels.showHelp) help(panels);
+  if (!panels.showPanels) {
+    panels.panelWidth = 0.0f;
+    return toLoad;
+  }
 
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  // On the right, a third of the window at most; collapsed at first on a small window.
-  const float width = std::min(360.0f, display.x * 0.34f);
-  ImGui::SetNextWindowPos(ImVec2(display.x - width - 10.0f, 10.0f), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(width, display.y - 20.0f), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowCollapsed(display.x < 800.0f, ImGuiCond_FirstUseEver);
+  // Anchored to the right edge, full height, 30 % of the window wide (230 to 380 points) and
+  // placed again whenever the window's size changes; collapsed on a window too small to hold it.
+  const bool resized = display.x != panels.lastDisplayWidth || display.y != panels.lastDisplayHeight;
+  const bool first = panels.lastDisplayWidth < 0.0f;
+  panels.lastDisplayWidth = display.x;
+  panels.lastDisplayHeight = display.y;
+  const float width = std::clamp(display.x * 0.3f, std::min(230.0f, display.x - 20.0f), 380.0f);
+  if (resized) {
+    ImGui::SetNextWindowPos(ImVec2(std::max(0.0f, display.x - width - 10.0f), 10.0f), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(std::max(1.0f, width), std::max(1.0f, display.y - 20.0f)), ImGuiCond_Always);
+    // Collapsed while the window is too small to hold it, and opened again when it grows back,
+    // unless the user collapsed it by hand.
+    const bool small = display.x < 500.0f || display.y < 300.0f;
+    if (first || small || panels.collapsedBySize) {
+      ImGui::SetNextWindowCollapsed(small, ImGuiCond_Always);
+      panels.collapsedBySize = small;
+    }
+  }
   ImGui::Begin("Drape");
+  noteWindow(panels);
+  panels.panelWidth = ImGui::IsWindowCollapsed() ? 0.0f : ImGui::GetWindowSize().x + 10.0f;
+  // Widgets leave room on their right for the longest label.
+  ImGui::PushItemWidth(-std::min(ImGui::CalcTextSize("pinch distance (m) ").x, ImGui::GetWindowWidth() * 0.42f));
 
   if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
-    static std::vector<std::filesystem::path> scenes = shippedScenes();
+    static const std::vector<ShippedScene> scenes = shippedScenes();
     const std::string current = session.path().stem().string();
     if (ImGui::BeginCombo("scene", current.c_str())) {
-      for (const std::filesystem::path& file : scenes) {
-        if (ImGui::Selectable(file.stem().string().c_str(), file.stem().string() == current)) toLoad = file;
+      noteWindow(panels);
+      for (const ShippedScene& shipped : scenes) {
+        if (ImGui::Selectable(shipped.name.c_str(), shipped.name == current)) toLoad = shipped.file;
+        if (!shipped.description.empty()) tip(shipped.description.c_str());
       }
       ImGui::EndCombo();
     }
+    if (!session.scene().description.empty()) {
+      ImGui::PushTextWrapPos(0.0f);
+      ImGui::TextDisabled("%s", session.scene().description.c_str());
+      ImGui::PopTextWrapPos();
+    }
     if (ImGui::Button(session.paused ? "run" : "pause")) session.paused = !session.paused;
     ImGui::SameLine();
-    if (ImGui::Button("step") && session.paused) session.step();
+    if (ImGui::Button("step")) {
+      // While running, a step pauses first: one step, then still.
+      if (session.paused) session.step();
+      session.paused = true;
+    }
+    tip("one step (pauses first while running; N or . does the same)");
     ImGui::SameLine();
     if (ImGui::Button("reset")) {
       session.reset();  // a new world: nothing below may use the old one
+      ImGui::PopItemWidth();
       ImGui::End();
       return toLoad;
     }
@@ -219,6 +321,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     // Every sheet made of a fabric in physical units (docs/fabric.md), or as the scene says.
     const std::string fabric = session.fabric().empty() ? "as the scene says" : session.fabric();
     if (ImGui::BeginCombo("fabric", fabric.c_str())) {
+      noteWindow(panels);
       std::optional<std::optional<std::string>> chosen;
       if (ImGui::Selectable("as the scene says", session.fabric().empty())) chosen.emplace(std::nullopt);
       for (const scene::FabricPreset& preset : scene::fabricPresets()) {
@@ -234,6 +337,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       ImGui::EndCombo();
       if (chosen) {
         session.setFabric(*chosen);  // a new world: nothing below may use the old one
+        ImGui::PopItemWidth();
         ImGui::End();
         return toLoad;
       }
@@ -275,35 +379,50 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   if (ImGui::CollapsingHeader("Solver", ImGuiTreeNodeFlags_DefaultOpen)) {
     // Model and integrator restart the scene (materials mean different things in the two models).
     int model = tuned.solver.model == sim::Model::position ? 0 : 1;
-    const char* models[] = {"position (Verlet + constraints)", "force (springs)"};
+    const char* models[] = {"position", "force (springs)"};
     int integrator = static_cast<int>(tuned.solver.integrator);
     const char* integrators[] = {"explicit Euler", "symplectic Euler", "Verlet", "midpoint", "RK4"};
     bool restart = ImGui::Combo("model", &model, models, 2);
+    tip("position: Verlet with constraints projected each substep (the seed's model); force: mass-spring forces "
+        "and an integrator. Changing it restarts the scene with that model's materials");
     if (model == 1) restart |= ImGui::Combo("integrator", &integrator, integrators, 5);
     if (restart) {
       session.setModel(model == 0 ? sim::Model::position : sim::Model::force, static_cast<sim::Integrator>(integrator));
+      ImGui::PopItemWidth();
       ImGui::End();
       return toLoad;
     }
     changed |= sliderReal("dt (s)", tuned.solver.dt, 0.001, 0.05, "%.4f", ImGuiSliderFlags_Logarithmic);
     // The force model may have taken hundreds to stay stable (scene::withModel): the slider reaches them.
     changed |= ImGui::SliderInt("substeps", &tuned.solver.substeps, 1, std::max(32, world.settings().solver.substeps));
-    changed |= ImGui::SliderInt("iterations", &tuned.solver.iterations, 0, 100);
+    // The force model has no constraint sweeps: its iterations would do nothing.
+    if (tuned.solver.model == sim::Model::position) {
+      changed |= ImGui::SliderInt("iterations", &tuned.solver.iterations, 0, 100);
+      tip("constraint sweeps a substep: more is stiffer and costs more");
+    }
     changed |= sliderReal("damping (1/s)", tuned.solver.damping, 0.0, 5.0);
     if (tuned.solver.model == sim::Model::position) {
       changed |= ImGui::Checkbox("XPBD", &tuned.solver.xpbd);
+      tip("extended position-based dynamics: stiffness means the same whatever the iterations and substeps");
       ImGui::SameLine();
       changed |= ImGui::Checkbox("tethers", &tuned.solver.tethers);
+      tip("long-range limits from every pinned particle: a hanging cloth cannot stretch past its length");
       ImGui::SameLine();
       changed |= ImGui::Checkbox("lines", &tuned.solver.lines);
+      tip("the fast sweep: each lattice line's stretch solved exactly at once, not link by link");
       // On a line of its own: the row above is full.
-      if (tuned.solver.lines) changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
+      if (tuned.solver.lines) {
+        changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
+        tip("lines: the bending of a line under tension in its solve (steadier under a finger's pull)");
+      }
       // Each on a line of its own: two do not fit side by side.
       if (tuned.solver.lines && tuned.solver.tethers) {
         changed |= ImGui::Checkbox("tethers between line steps", &tuned.solver.tethersBetweenSteps);
+        tip("tethers projected again between the line steps, not only after them");
       }
       if (tuned.solver.lines) {
         changed |= ImGui::SliderInt("extra steps", &tuned.solver.extraLineSteps, 0, 8);
+        tip("line steps a sweep may add while a link is stretched more than 'max stretch'");
         if (tuned.solver.extraLineSteps > 0) {
           changed |= sliderReal("max stretch", tuned.solver.stretchTolerance, 0.0, 0.2, "%.3f");
         }
@@ -314,23 +433,34 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     if (ImGui::SliderInt("threads", &threads, 1, std::max(cores, 2))) session.setThreads(threads);
     changed |= ImGui::Checkbox("tearing", &tuned.tearing.enabled);
     changed |= sliderReal("tear at (x rest)", tuned.tearing.threshold, 1.01, 5.0);
+    tip("a link tears when stretched to this many times its rest length");
   }
   if (ImGui::CollapsingHeader("World")) {
     changed |= vector3("gravity (m/s^2)", tuned.gravity, 0.05f);
     changed |= vector3("wind (m/s)", tuned.air.velocity, 0.05f);
     changed |= sliderReal("drag (1/s)", tuned.air.drag, 0.0, 5.0);
     changed |= sliderReal("wind pressure", tuned.air.pressure, 0.0, 20.0);
+    tip("kg/(m^2 s): the wind pushing on each triangle by how squarely it faces it (a sail's push); "
+        "drag acts on every particle alike");
     for (std::size_t i = 0; i < tuned.colliders.size(); ++i) {
       ImGui::PushID(static_cast<int>(i));
       sim::Friction& f = tuned.colliders[i].friction;
-      ImGui::Text("collider %zu", i);
+      const sim::ColliderShape shape = tuned.colliders[i].shape;
+      ImGui::Text("collider %zu: %s", i,
+                  shape == sim::ColliderShape::plane    ? "the table (a plane)"
+                  : shape == sim::ColliderShape::sphere ? "a ball"
+                  : shape == sim::ColliderShape::box    ? "a box"
+                  : shape == sim::ColliderShape::capsule ? "a capsule"
+                                                          : "a mesh");
       changed |= sliderReal("static friction", f.staticCoefficient, 0.0, 2.0);
       changed |= sliderReal("kinetic friction", f.kineticCoefficient, 0.0, 2.0);
       ImGui::PopID();
     }
     if (tuned.solver.model == sim::Model::position) {
       changed |= ImGui::Checkbox("self-collision", &tuned.selfCollision.enabled);
+      tip("cloth never passes through itself or another cloth (docs/self-contact.md)");
       changed |= sliderReal("self distance (m)", tuned.selfCollision.distance, 0.001, 0.1);
+      tip("how far apart two layers of cloth are kept");
     }
   }
   if (changed) session.tune(tuned);
@@ -386,17 +516,45 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::PlotLines("##energy", panels.energy.data(), History::kLength, panels.energy.offset(), overlay, FLT_MAX,
                      FLT_MAX, plot);
   }
+  ImGui::PopItemWidth();
   ImGui::End();
   return toLoad;
 }
 
-render::Overlay fingerOverlay(Session& session) {
+OutlineSize outlineSize(const std::vector<glm::dvec3>& stroke, double spacing) {
+  OutlineSize size;
+  if (stroke.empty() || !(spacing > 0.0)) return size;
+  glm::dvec2 lower{stroke.front().x, stroke.front().z}, upper = lower;
+  double twiceArea = 0.0, perimeter = 0.0;
+  for (std::size_t i = 0; i < stroke.size(); ++i) {
+    const glm::dvec2 a{stroke[i].x, stroke[i].z};
+    const glm::dvec2 b{stroke[(i + 1) % stroke.size()].x, stroke[(i + 1) % stroke.size()].z};
+    lower = glm::min(lower, a);
+    upper = glm::max(upper, a);
+    twiceArea += a.x * b.y - b.x * a.y;
+    perimeter += glm::length(b - a);
+  }
+  size.width = upper.x - lower.x;
+  size.depth = upper.y - lower.y;
+  size.particles = std::abs(twiceArea) / 2.0 / (spacing * spacing) + perimeter / spacing / 2.0 + 1.0;
+  return size;
+}
+
+render::Overlay fingerOverlay(Session& session, const InputMapper& input) {
   render::Overlay overlay;
   const interact::Interaction& interaction = session.interaction();
   for (const interact::TouchView& touch : interaction.touches()) {
     if (touch.mode == interact::Mode::sticky) {
-      const glm::vec4 colour = touch.pinched ? glm::vec4{1.0f, 0.85f, 0.2f, 1.0f} : glm::vec4{1.0f, 1.0f, 1.0f, 1.0f};
+      const glm::vec4 colour = touch.pinched          ? glm::vec4{1.0f, 0.85f, 0.2f, 1.0f}
+                               : input.parked(touch.id) ? glm::vec4{0.3f, 0.9f, 1.0f, 1.0f}
+                                                        : glm::vec4{1.0f, 1.0f, 1.0f, 1.0f};
       overlay.addRing(touch.position, interaction.settings().radius, glm::dvec3{0.0, 1.0, 0.0}, colour);
+      if (touch.position.y - touch.base.y > 1e-3) {
+        // Lifted: a line down to where it would be on its plane, and a small ring there.
+        overlay.lines.push_back({glm::vec3(touch.position), colour});
+        overlay.lines.push_back({glm::vec3(touch.base), colour});
+        overlay.addRing(touch.base, interaction.settings().radius * 0.4, glm::dvec3{0.0, 1.0, 0.0}, colour, 16);
+      }
     } else {
       overlay.addStroke(touch.stroke, touch.mode == interact::Mode::cut ? glm::vec4{0.95f, 0.15f, 0.1f, 1.0f}
                                                                         : glm::vec4{0.15f, 0.35f, 0.95f, 1.0f});

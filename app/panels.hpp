@@ -28,6 +28,9 @@ enum class KeyAction : std::uint8_t {
   panels,
   save,
   load,
+  frame,      // F: the cloths fill the view
+  resetView,  // Home: the camera as the scene starts
+  askQuit,    // Esc: quits when pressed twice
   quit
 };
 
@@ -60,6 +63,12 @@ struct FrameStats {
 };
 
 struct PanelState {
+  // The panels' windows as they were last drawn, in normalised window coordinates: an event over
+  // one goes to the panels (overAny), decided for each event as it comes.
+  std::vector<ScreenRect> windows;
+  float panelWidth = 0.0f;  // points, of the main panel as last drawn (0 when hidden)
+  float lastDisplayWidth = -1.0f, lastDisplayHeight = -1.0f;  // the panel is placed again when these change
+  bool collapsedBySize = false;  // the panel was collapsed because the window was too small
   bool showHelp = false;
   bool showPanels = true;
   bool wantScreenshot = false;
@@ -91,7 +100,16 @@ void applyKey(KeyAction action, Session& session, PanelState& panels);
 std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& panels, FrameStats& stats,
                                                 const InputMapper& input);
 
-// Rings for sticky fingers, paths for cuts and outlines being drawn.
-render::Overlay fingerOverlay(Session& session);
+// Rings for sticky fingers (a parked one in cyan, a pinched one in yellow; a lifted one with a line
+// down to its plane), paths for cuts and outlines being drawn.
+render::Overlay fingerOverlay(Session& session, const InputMapper& input);
+
+// The outline a create finger is drawing, as the cloth it would make: width and depth (m) and about
+// how many particles at `spacing` (the mesher's count: cells plus half the perimeter in spacings).
+struct OutlineSize {
+  double width = 0.0, depth = 0.0;
+  double particles = 0.0;
+};
+OutlineSize outlineSize(const std::vector<glm::dvec3>& stroke, double spacing);
 
 }  // namespace drape::app

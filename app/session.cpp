@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -58,13 +59,82 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
   interaction_->afterSpawn = [this] { undo_.push_back({Undo::Kind::spawn, {}}); };
   interaction_->tell = [this](const std::string& line) { status = line; };
   undo_.clear();
-  frame();
+  resetView();
 }
 
-void Session::frame() {
+namespace {
+
+constexpr double kYaw = 0.6, kPitch = 0.45;  // from the front right, a little above
+
+// The height of the table: the highest plane collider facing (nearly) up, if there is one.
+std::optional<double> tableHeight(const sim::World& world) {
+  std::optional<double> height;
+  for (const sim::Collider& collider : world.colliders()) {
+    const sim::ColliderSettings& s = collider.settings();
+    if (s.shape != sim::ColliderShape::plane) continue;
+    const glm::dvec3 up = s.orientation * s.normal;
+    if (glm::length(up) > 0.0 && glm::normalize(up).y > 0.99) {
+      height = std::max(height.value_or(-1e300), collider.centre().y);
+    }
+  }
+  return height;
+}
+
+}  // namespace
+
+void Session::setView(double aspect, double coveredRight) {
+  if (aspect > 0.0 && std::isfinite(aspect)) viewAspect_ = aspect;
+  if (std::isfinite(coveredRight)) viewCovered_ = std::clamp(coveredRight, 0.0, 0.7);
+}
+
+void Session::frame(glm::dvec3 lower, glm::dvec3 upper, double yaw, double pitch) {
+  const double uncovered = 1.0 - viewCovered_;
+  camera_ = render::Camera::framing(lower, upper, yaw, pitch, viewAspect_ * uncovered);
+  // Centred in the part of the window the panels leave: the eye moves right by half the covered
+  // part's width at the target's distance, so the scene moves left.
+  const double halfWidth = std::tan(camera_.fieldOfView / 2.0) * viewAspect_;  // in camera distances
+  camera_.pan(halfWidth * viewCovered_, 0.0);
+}
+
+void Session::resetView() {
   glm::dvec3 lower, upper;
   render::sceneBounds(*world_, lower, upper);
-  camera_ = render::Camera::framing(lower, upper, 0.6, 0.45, 16.0 / 10.0);
+  const bool onlyTable = world_->cloths().empty() &&
+                         std::all_of(world_->colliders().begin(), world_->colliders().end(), [](const sim::Collider& c) {
+                           return c.settings().shape == sim::ColliderShape::plane;
+                         });
+  if (onlyTable) {
+    // Nothing on the table: 80 cm of it, so that an outline a quarter of the window wide makes a
+    // cloth about half a metre across, as the desk's (sceneBounds would frame two metres and more).
+    const double y = tableHeight(*world_).value_or(0.0);
+    lower = glm::dvec3{-0.4, y, -0.4};
+    upper = glm::dvec3{0.4, y + 0.1, 0.4};
+  }
+  frame(lower, upper, kYaw, kPitch);
+}
+
+void Session::frameCloths() {
+  glm::dvec3 lower{std::numeric_limits<double>::max()}, upper{std::numeric_limits<double>::lowest()};
+  for (const sim::Cloth& cloth : world_->cloths()) {
+    for (const sim::Vec3& x : cloth.state.position) {
+      lower = glm::min(lower, x);
+      upper = glm::max(upper, x);
+    }
+  }
+  if (lower.x > upper.x) {
+    status = "no cloth to frame";
+    return;
+  }
+  frame(lower, upper, camera_.yaw, camera_.pitch);
+  status = "framed the cloth";
+}
+
+void Session::keepCameraAboveTable() {
+  const std::optional<double> table = tableHeight(*world_);
+  if (!table) return;
+  // The eye is at target.y + distance sin(pitch): at least 1 cm over the table.
+  const double lowest = std::clamp((*table + 0.01 - camera_.target.y) / camera_.distance, -1.0, 1.0);
+  camera_.pitch = std::clamp(std::max(camera_.pitch, std::asin(lowest)), -1.5, 1.5);
 }
 
 std::optional<std::string> Session::load(const std::filesystem::path& file) {
@@ -117,6 +187,9 @@ void Session::reset() {
 
 std::optional<std::string> Session::setModel(sim::Model model, sim::Integrator integrator) {
   scene::Scene changed = scene::withModel(scene_, model, integrator);
+  // What the panels tuned of the air and gravity means the same in either model: it stays.
+  changed.world.gravity = world_->settings().gravity;
+  changed.world.air = world_->settings().air;
   try {
     auto world = std::make_unique<sim::World>(changed.world);
     const render::Camera keep = camera_;

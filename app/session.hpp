@@ -64,6 +64,17 @@ class Session {
   // Takes back the last cloth drawn or the last cut. False when there is nothing to take back.
   bool undo();
 
+  // The window the camera draws into: its aspect, and the fraction of its width the panels cover
+  // on the right. Framing centres the scene in the part left uncovered.
+  void setView(double aspect, double coveredRight);
+  // The camera as a scene starts: the whole scene from the front right (Home).
+  void resetView();
+  // The cloths, as they are now, filling the view from where the camera looks now (F).
+  void frameCloths();
+  // Keeps the eye above the table (a plane collider facing up), so orbiting cannot hide the scene
+  // under it; called every frame.
+  void keepCameraAboveTable();
+
   const scene::Scene& scene() const { return scene_; }
   sim::World& world() { return *world_; }
   const sim::World& world() const { return *world_; }
@@ -84,7 +95,7 @@ class Session {
     std::vector<sim::Cloth> cloths;  // cut: the cloths before it
   };
   void adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const std::filesystem::path& path);
-  void frame();
+  void frame(glm::dvec3 lower, glm::dvec3 upper, double yaw, double pitch);
 
   scene::Scene scene_;
   std::filesystem::path path_;
@@ -93,6 +104,8 @@ class Session {
   render::Camera camera_;
   std::vector<Undo> undo_;
   int threads_ = 1;
+  double viewAspect_ = 16.0 / 10.0;
+  double viewCovered_ = 0.0;
   std::string fabric_;
 };
 

@@ -131,6 +131,8 @@ TEST_F(App, AMouseDragWithXdotoolMovesTheCloth) {
       "xdotool mouseup 1\n"
       "sleep 0.5\n"
       "xdotool key --window $window Escape\n"
+      "sleep 0.3\n"
+      "xdotool key --window $window Escape\n"
       "wait $app");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto middle = [](const json& document) {
@@ -164,6 +166,49 @@ TEST_F(App, ResizingAndMinimisingDoNotStopIt) {
       "wait $app");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   EXPECT_TRUE(state(file("state.json"))["cloths"][0].contains("positions"));
+}
+
+// Share of a band of columns [from, to) (fractions of the width) in the panels' dark background.
+double darkShare(const fs::path& png, double from, double to) {
+  int width = 0, height = 0, channels = 0;
+  unsigned char* pixels = stbi_load(png.string().c_str(), &width, &height, &channels, 4);
+  if (!pixels) return -1.0;
+  long dark = 0, all = 0;
+  for (int y = 0; y < height; ++y) {
+    for (int x = static_cast<int>(from * width); x < static_cast<int>(to * width); ++x) {
+      const unsigned char* p = pixels + 4 * (static_cast<long>(y) * width + x);
+      dark += p[0] < 60 && p[1] < 60 && p[2] < 70;
+      ++all;
+    }
+  }
+  stbi_image_free(pixels);
+  return all > 0 ? static_cast<double>(dark) / static_cast<double>(all) : -1.0;
+}
+
+TEST_F(App, ThePanelStaysAtTheRightEdgeThroughAResizeToOnePixelAndBack) {
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk --width 800 --height 500 --exit-after 100000 &\n"
+      "app=$!\n"
+      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
+      "[ -n \"$window\" ]\n"
+      "sleep 0.5\n"
+      "xdotool windowsize $window 1 1\n"
+      "sleep 0.5\n"
+      "xdotool windowsize $window 900 600\n"
+      "sleep 1\n"
+      "xdotool key --window $window p\n"  // a screenshot: drape-screenshot-001.png
+      "sleep 1\n"
+      "xdotool key --window $window Escape\n"
+      "sleep 0.3\n"
+      "xdotool key --window $window Escape\n"  // the second Esc quits
+      "wait $app");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const fs::path shot = file("drape-screenshot-001.png");
+  ASSERT_TRUE(fs::exists(shot));
+  // The panel fills the right edge from top to bottom; the left half is the scene (and the HUD,
+  // which is lighter than the panel).
+  EXPECT_GT(darkShare(shot, 0.80, 0.97), 0.6);
+  EXPECT_LT(darkShare(shot, 0.0, 0.5), 0.05);
 }
 
 TEST_F(App, RecordingWritesAScriptThatReplays) {

@@ -417,5 +417,73 @@ TEST(Session, AFabricTakesTheForceModelToThePositionModelAndRefusesASceneWithout
   EXPECT_TRUE(chain.fabric().empty());
 }
 
+TEST(Session, FramingLeavesThePanelsPartOfTheWindowAndFFramesTheClothWhereverItIs) {
+  Session session("desk");
+  const double aspect = 16.0 / 10.0;
+  const auto clothOnScreen = [&](double& left, double& right) {
+    left = 1.0, right = 0.0;
+    for (const sim::Vec3& x : session.world().cloths()[0].state.position) {
+      const std::optional<glm::dvec2> at = session.camera().project(x, aspect);
+      ASSERT_TRUE(at);
+      left = std::min(left, at->x);
+      right = std::max(right, at->x);
+    }
+  };
+  double left = 0.0, right = 0.0;
+  session.setView(aspect, 0.3);  // a panel over the right 30 %
+  session.resetView();
+  clothOnScreen(left, right);
+  EXPECT_GT(left, 0.0);
+  EXPECT_LT(right, 0.7);                             // clear of the panel
+  EXPECT_NEAR((left + right) / 2.0, 0.35, 0.05);     // in the middle of what is left
+  // Carry the cloth off to one side and look elsewhere: F brings it back into view.
+  std::vector<sim::Cloth> moved = session.world().cloths();
+  for (sim::Vec3& x : moved[0].state.position) x += sim::Vec3{3.0, 0.0, -2.0};
+  for (sim::Vec3& x : moved[0].state.previousPosition) x += sim::Vec3{3.0, 0.0, -2.0};
+  session.world().restoreCloths(std::move(moved));
+  session.camera().orbit(1.0, 0.2);
+  const double yaw = session.camera().yaw;
+  session.frameCloths();
+  EXPECT_DOUBLE_EQ(session.camera().yaw, yaw);  // from where the camera looks now
+  clothOnScreen(left, right);
+  EXPECT_GT(left, 0.0);
+  EXPECT_LT(right, 0.7);
+  session.resetView();
+  EXPECT_NE(session.camera().yaw, yaw);
+}
+
+TEST(Session, OrbitingBelowTheTableStopsAtItAndAnEmptyTableIsFramedAsTheDesk) {
+  Session session("empty-table");
+  // 80 cm of table: the view is about 2 m wide at the target, as the desk's is, not 5.
+  const render::Camera& camera = session.camera();
+  const auto width = [](const render::Camera& c) { return 2.0 * c.distance * std::tan(c.fieldOfView / 2.0) * 1.6; };
+  EXPECT_LT(width(camera), 2.5);
+  EXPECT_GT(width(camera), 1.5);
+  Session desk("desk");
+  EXPECT_LT(width(camera), 1.5 * width(desk.camera()));
+  session.camera().orbit(0.0, -3.0);  // far below the horizon
+  EXPECT_LT(session.camera().eye().y, 0.0);
+  session.keepCameraAboveTable();
+  EXPECT_NEAR(session.camera().eye().y, 0.01, 1e-9);
+  // A scene with no table lets the camera go anywhere.
+  Session hang("hang");
+  hang.camera().orbit(0.0, -3.0);
+  const double pitch = hang.camera().pitch;
+  hang.keepCameraAboveTable();
+  EXPECT_EQ(hang.camera().pitch, pitch);
+}
+
+TEST(Session, AnotherModelKeepsTheTunedWindAndDrag) {
+  Session session("hang");
+  sim::WorldSettings tuned = session.world().settings();
+  tuned.air.velocity = sim::Vec3{1.5, 0.0, 0.5};
+  tuned.air.drag = 0.7;
+  ASSERT_FALSE(session.tune(tuned));
+  ASSERT_FALSE(session.setModel(sim::Model::force, sim::Integrator::symplecticEuler));
+  EXPECT_EQ(session.world().settings().solver.model, sim::Model::force);
+  EXPECT_EQ(session.world().settings().air.velocity, tuned.air.velocity);
+  EXPECT_EQ(session.world().settings().air.drag, 0.7);
+}
+
 }  // namespace
 }  // namespace drape::app

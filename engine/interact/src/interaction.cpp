@@ -371,8 +371,8 @@ bool Interaction::undoSpawn() {
 std::vector<TouchView> Interaction::touches() const {
   std::vector<TouchView> views;
   for (const Touch& touch : touches_) {
-    views.push_back({touch.id, touch.mode, touch.onPlane + kUp * (touch.height + touch.pinch), touch.stroke,
-                     touch.holds, touch.pinch > 0.0});
+    views.push_back({touch.id, touch.mode, touch.onPlane + kUp * (touch.height + touch.pinch), touch.onPlane,
+                     touch.stroke, touch.holds, touch.pinch > 0.0});
   }
   return views;
 }

@@ -84,6 +84,7 @@ struct TouchView {
   int id;
   Mode mode;
   Vec3 position;             // m, where it is (including lifts)
+  Vec3 base;                 // m, where it is in its plane (without them)
   std::vector<Vec3> stroke;  // create and cut: the path so far
   bool holds;                // sticky: it holds particles
   bool pinched;              // sticky: it is pinch-lifted
