@@ -1,5 +1,9 @@
-// The renderer in a real off-screen context: what it uploads when, and which way up pictures are.
+// The renderer in a real off-screen context: what it uploads when, which way up pictures are, and
+// what the views (table, weave, wireframe, particles) put on the picture.
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include "context.hpp"
 #include "drape/render/renderer.hpp"
@@ -75,6 +79,100 @@ TEST_F(RendererTest, AMinimisedWindowDrawsNothingAndDoesNotFail) {
   renderer_->render(world, Camera{}, 0, 0, {});
   renderer_->render(world, Camera{}, kWidth, kHeight, {});
   EXPECT_EQ(renderer_->uploadsOfTopology(), 1);
+}
+
+// A camera looking straight down at the sheet's middle from 2 m.
+Camera fromAbove(double height) {
+  Camera camera;
+  camera.target = {0.0, height, 0.0};
+  camera.yaw = 0.0;
+  camera.pitch = 1.5;
+  camera.distance = 2.0;
+  return camera;
+}
+
+TEST_F(RendererTest, TheTableIsDrawnOnlyWhereTheWorldHasOne) {
+  // Looking along the horizon from above a sheet: the lower half of the picture is where a floor
+  // would be. Without a table it shows the background's colour and nothing else.
+  sim::WorldSettings settings = sheet(3.0);
+  Camera camera;
+  camera.target = {0.0, 3.0, 0.0};
+  camera.pitch = 0.3;
+  camera.distance = 4.0;
+  FrameOptions options;
+  const auto background = [&](const std::vector<std::uint8_t>& rgba) {
+    int same = 0;
+    for (int y = kHeight * 3 / 4; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const std::uint8_t* p = &rgba[static_cast<std::size_t>((y * kWidth + x) * 4)];
+        same += std::abs(p[0] - std::lround(options.backgroundColour.r * 255.0f)) <= 1 &&
+                std::abs(p[1] - std::lround(options.backgroundColour.g * 255.0f)) <= 1 &&
+                std::abs(p[2] - std::lround(options.backgroundColour.b * 255.0f)) <= 1;
+      }
+    }
+    return static_cast<double>(same) / (kWidth * kHeight / 4);
+  };
+  const sim::World floating(settings);
+  renderer_->render(floating, camera, kWidth, kHeight, options);
+  EXPECT_GT(background(renderer_->readPixels(kWidth, kHeight)), 0.99);
+  settings.colliders.push_back(sim::ColliderSettings{});  // a plane through the origin, facing up
+  const sim::World onTable(settings);
+  renderer_->render(onTable, camera, kWidth, kHeight, options);
+  EXPECT_LT(background(renderer_->readPixels(kWidth, kHeight)), 0.05);
+}
+
+// Mean and spread of the brightness of the pixels in the middle quarter of the picture.
+void brightness(const std::vector<std::uint8_t>& rgba, double& mean, double& spread, int& dark, int& white) {
+  double sum = 0.0, squares = 0.0;
+  int n = 0;
+  dark = 0;
+  white = 0;
+  for (int y = kHeight * 3 / 8; y < kHeight * 5 / 8; ++y) {
+    for (int x = kWidth * 3 / 8; x < kWidth * 5 / 8; ++x) {
+      const std::uint8_t* p = &rgba[static_cast<std::size_t>((y * kWidth + x) * 4)];
+      const double v = (p[0] + p[1] + p[2]) / 3.0;
+      sum += v;
+      squares += v * v;
+      dark += v < 50.0;
+      white += std::min({p[0], p[1], p[2]}) > 225;
+      ++n;
+    }
+  }
+  mean = sum / n;
+  spread = std::sqrt(std::max(squares / n - mean * mean, 0.0));
+}
+
+TEST_F(RendererTest, TheWeavePrintsAChecksAndTheWireframeAndParticlesDrawOverTheSurface) {
+  // A 1 m sheet seen from above fills the middle of the picture: plain, it is one colour; woven,
+  // its 5 cm checks make bands of white and colour; its edges (wireframe) and particles add dark
+  // lines and white dots.
+  const sim::World world(sheet(1.0));
+  const Camera camera = fromAbove(1.0);
+  double mean = 0.0, spread = 0.0;
+  int dark = 0, white = 0;
+  FrameOptions plain;
+  plain.woven = false;
+  renderer_->render(world, camera, kWidth, kHeight, plain);
+  brightness(renderer_->readPixels(kWidth, kHeight), mean, spread, dark, white);
+  const double plainSpread = spread, plainMean = mean;
+  EXPECT_EQ(dark, 0);
+  EXPECT_EQ(white, 0);
+  FrameOptions woven;
+  renderer_->render(world, camera, kWidth, kHeight, woven);
+  brightness(renderer_->readPixels(kWidth, kHeight), mean, spread, dark, white);
+  EXPECT_GT(spread, plainSpread + 10.0);
+  EXPECT_GT(mean, plainMean);  // the white threads
+  FrameOptions wireframe = plain;
+  wireframe.wireframe = true;
+  renderer_->render(world, camera, kWidth, kHeight, wireframe);
+  brightness(renderer_->readPixels(kWidth, kHeight), mean, spread, dark, white);
+  const int wires = dark;
+  EXPECT_GT(wires, 20);  // an 8 x 8 sheet's edges cross the middle
+  FrameOptions particles = plain;
+  particles.particles = true;
+  renderer_->render(world, camera, kWidth, kHeight, particles);
+  brightness(renderer_->readPixels(kWidth, kHeight), mean, spread, dark, white);
+  EXPECT_GT(white, 0);  // the dots
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "collider_geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -69,29 +70,38 @@ void quad(const Frame& frame, sim::Vec3 centre, sim::Vec3 normal, sim::Vec3 u, s
 
 }  // namespace
 
-void appendColliderGeometry(const sim::Collider& collider, ColliderGeometry& out) {
+bool showsAsTable(const sim::Collider& collider) {
+  const sim::ColliderSettings& s = collider.settings();
+  if (s.shape != sim::ColliderShape::plane) return false;
+  const sim::Vec3 worldNormal = collider.orientation() * glm::normalize(s.normal);
+  // A plane through the origin within ~8 degrees of level.
+  return worldNormal.y > 0.99 && std::abs(collider.centre().y) < 1e-6;
+}
+
+void appendColliderGeometry(const sim::Collider& collider, ColliderGeometry& out, double inset) {
   const sim::ColliderSettings& s = collider.settings();
   const Frame frame{collider.centre(), collider.orientation()};
+  inset = std::isfinite(inset) ? std::max(inset, 0.0) : 0.0;
   switch (s.shape) {
     case sim::ColliderShape::plane: {
+      if (showsAsTable(collider)) return;
       const sim::Vec3 n = glm::normalize(s.normal);
-      const sim::Vec3 worldNormal = collider.orientation() * n;
-      // A plane through the origin within ~8 degrees of level is shown by the table itself.
-      if (worldNormal.y > 0.99 && std::abs(collider.centre().y) < 1e-6) return;
       sim::Vec3 u, v;
       basis(n, u, v);
-      quad(frame, sim::Vec3{0.0}, n, u * 1.5, v * 1.5, out);
+      quad(frame, -n * inset, n, u * 1.5, v * 1.5, out);
       return;
     }
-    case sim::ColliderShape::sphere: sweptSphere(frame, {0, 1, 0}, sim::Vec3{0.0}, s.radius, out); return;
+    case sim::ColliderShape::sphere:
+      sweptSphere(frame, {0, 1, 0}, sim::Vec3{0.0}, std::max(s.radius - inset, 0.5 * s.radius), out);
+      return;
     case sim::ColliderShape::capsule: {
       const double length = glm::length(s.halfAxis);
       const sim::Vec3 axis = length > 0.0 ? s.halfAxis / length : sim::Vec3{1, 0, 0};
-      sweptSphere(frame, axis, s.halfAxis, s.radius, out);
+      sweptSphere(frame, axis, s.halfAxis, std::max(s.radius - inset, 0.5 * s.radius), out);
       return;
     }
     case sim::ColliderShape::box: {
-      const sim::Vec3 h = s.halfExtents;
+      const sim::Vec3 h = glm::max(s.halfExtents - sim::Vec3{inset}, 0.5 * s.halfExtents);
       for (int axis = 0; axis < 3; ++axis) {
         for (double side : {-1.0, 1.0}) {
           sim::Vec3 n{0.0}, u{0.0}, v{0.0};

@@ -85,14 +85,68 @@ void setVec3(GLuint program, const char* name, glm::vec3 v) {
   glUniform3fv(uniform(program, name), 1, glm::value_ptr(v));
 }
 
-// One cloth on the GPU: streamed positions, normals and strains, and its (topology) indices.
+// One cloth on the GPU: streamed positions, normals and strains, its rest coordinates and its
+// (topology) indices.
 struct GpuCloth {
-  GLuint vao = 0, positions = 0, normals = 0, strains = 0, indices = 0;
+  GLuint vao = 0, positions = 0, normals = 0, strains = 0, restCoordinates = 0, indices = 0;
   GLsizei triangleIndexCount = 0;
-  GLuint lineVao = 0, lineIndices = 0;  // chains: links drawn as lines with the overlay program
+  // Drawn with the overlay program from the same positions: a chain's links, or a sheet's
+  // triangle edges (the wireframe view).
+  GLuint lineVao = 0, lineIndices = 0;
   GLsizei lineIndexCount = 0;
+  bool chain = false;
   std::size_t particles = 0;
 };
+
+// Every particle's rest position in the cloth's rest plane (m): the plane's normal is the sum of
+// the rest triangles' area vectors; its first axis is x where the plane allows (else z), so a
+// sheet lying on the table or hanging in xy has its lattice's axes. The printed pattern follows
+// these, stretching and shearing with the cloth; a tear's copies of a particle share its place.
+std::vector<glm::vec2> restPlaneCoordinates(const sim::ClothRest& rest) {
+  sim::Vec3 normal{0.0};
+  for (const glm::uvec3& t : rest.triangles) {
+    const sim::Vec3 a(rest.restOffsets[t.x]), b(rest.restOffsets[t.y]), c(rest.restOffsets[t.z]);
+    normal += glm::cross(b - a, c - a);
+  }
+  normal = glm::length(normal) > 0.0 ? glm::normalize(normal) : sim::Vec3{0.0, 1.0, 0.0};
+  const sim::Vec3 axis = std::abs(normal.x) < 0.9 ? sim::Vec3{1.0, 0.0, 0.0} : sim::Vec3{0.0, 0.0, 1.0};
+  const sim::Vec3 u = glm::normalize(axis - normal * glm::dot(axis, normal)), v = glm::cross(normal, u);
+  std::vector<glm::vec2> coordinates;
+  coordinates.reserve(rest.restOffsets.size());
+  for (const glm::vec3& offset : rest.restOffsets) {
+    const sim::Vec3 p(offset);
+    coordinates.emplace_back(static_cast<float>(glm::dot(p, u)), static_cast<float>(glm::dot(p, v)));
+  }
+  return coordinates;
+}
+
+// Each edge of the triangles once, as pairs of particle indices.
+std::vector<std::uint32_t> triangleEdges(const std::vector<glm::uvec3>& triangles) {
+  std::vector<std::uint64_t> keys;
+  keys.reserve(triangles.size() * 3);
+  for (const glm::uvec3& t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+      keys.push_back((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b));
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<std::uint32_t> pairs;
+  pairs.reserve(keys.size() * 2);
+  for (const std::uint64_t key : keys) {
+    pairs.push_back(static_cast<std::uint32_t>(key >> 32));
+    pairs.push_back(static_cast<std::uint32_t>(key & 0xffffffffu));
+  }
+  return pairs;
+}
+
+// The level plane through the origin is the table the renderer draws (collider_geometry.hpp).
+bool hasTable(const sim::World& world) {
+  return std::any_of(world.colliders().begin(), world.colliders().end(), [](const sim::Collider& c) {
+    return c.settings().shape == sim::ColliderShape::plane && showsAsTable(c);
+  });
+}
 
 }  // namespace
 
@@ -113,6 +167,14 @@ void Overlay::addStroke(const std::vector<glm::dvec3>& stroke, glm::vec4 colour)
     lines.push_back({glm::vec3(stroke[i - 1]), colour});
     lines.push_back({glm::vec3(stroke[i]), colour});
   }
+}
+
+glm::vec3 strainColour(float strain, float scale) {
+  const float t = std::clamp(strain / std::max(scale, 1e-6f), 0.0f, 1.0f);
+  const glm::vec3 cold{0.15f, 0.35f, 0.85f}, mid{0.2f, 0.8f, 0.3f}, warm{0.95f, 0.85f, 0.2f}, hot{0.9f, 0.1f, 0.1f};
+  if (t < 0.33f) return glm::mix(cold, mid, t / 0.33f);
+  if (t < 0.66f) return glm::mix(mid, warm, (t - 0.33f) / 0.33f);
+  return glm::mix(warm, hot, (t - 0.66f) / 0.34f);
 }
 
 void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
@@ -169,8 +231,8 @@ struct Renderer::Impl {
     for (GpuCloth& c : cloths) {
       glDeleteVertexArrays(1, &c.vao);
       glDeleteVertexArrays(1, &c.lineVao);
-      const GLuint buffers[] = {c.positions, c.normals, c.strains, c.indices, c.lineIndices};
-      glDeleteBuffers(5, buffers);
+      const GLuint buffers[] = {c.positions, c.normals, c.strains, c.restCoordinates, c.indices, c.lineIndices};
+      glDeleteBuffers(6, buffers);
     }
     cloths.clear();
   }
@@ -193,24 +255,33 @@ struct Renderer::Impl {
       attribute(gpu.positions, 0, 3, bytes3);
       attribute(gpu.normals, 1, 3, bytes3);
       attribute(gpu.strains, 2, 1, static_cast<GLsizeiptr>(gpu.particles * sizeof(float)));
+      const std::vector<glm::vec2> coordinates = restPlaneCoordinates(cloth.rest);
+      attribute(gpu.restCoordinates, 3, 2, static_cast<GLsizeiptr>(coordinates.size() * sizeof(glm::vec2)));
+      glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(coordinates.size() * sizeof(glm::vec2)),
+                      coordinates.data());
       glGenBuffers(1, &gpu.indices);
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.indices);
       glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(cloth.rest.triangles.size() * sizeof(glm::uvec3)),
                    cloth.rest.triangles.data(), GL_STATIC_DRAW);
       gpu.triangleIndexCount = static_cast<GLsizei>(cloth.rest.triangles.size() * 3);
-      if (cloth.rest.triangles.empty()) {
-        // A chain: its stretch links as lines, positions from the same buffer, no normals.
-        std::vector<std::uint32_t> links;
+      // A chain: its stretch links as lines; a sheet: its triangles' edges (for the wireframe).
+      // Positions come from the same buffer; the colour is set as each is drawn.
+      gpu.chain = cloth.rest.triangles.empty();
+      std::vector<std::uint32_t> links;
+      if (gpu.chain) {
         for (const sim::DistanceConstraint& c : cloth.rest.of(sim::ConstraintKind::stretch)) {
           links.push_back(c.a);
           links.push_back(c.b);
         }
+      } else {
+        links = triangleEdges(cloth.rest.triangles);
+      }
+      {
         glGenVertexArrays(1, &gpu.lineVao);
         glBindVertexArray(gpu.lineVao);
         glBindBuffer(GL_ARRAY_BUFFER, gpu.positions);
         glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
         glEnableVertexAttribArray(0);
-        glVertexAttrib4f(1, 0.15f, 0.15f, 0.18f, 1.0f);
         glGenBuffers(1, &gpu.lineIndices);
         glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.lineIndices);
         glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(links.size() * sizeof(std::uint32_t)),
@@ -398,8 +469,12 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   for (std::size_t c = 0; c < world.cloths().size(); ++c) {
     r.streamCloth(world.cloths()[c], r.cloths[c], options.strainMap);
   }
+  // Colliders are drawn inside the thinnest cloth's thickness (collider_geometry.hpp).
+  double inset = std::numeric_limits<double>::max();
+  for (const sim::Cloth& cloth : world.cloths()) inset = std::min(inset, cloth.settings.thickness);
+  if (world.cloths().empty()) inset = 0.0;
   r.colliderGeometry.clear();
-  for (const sim::Collider& collider : world.colliders()) appendColliderGeometry(collider, r.colliderGeometry);
+  for (const sim::Collider& collider : world.colliders()) appendColliderGeometry(collider, r.colliderGeometry, inset);
   const auto colliderIndexCount = static_cast<GLsizei>(r.colliderGeometry.indices.size());
   if (colliderIndexCount > 0) {
     const ColliderGeometry& g = r.colliderGeometry;
@@ -430,11 +505,14 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glDisable(GL_CULL_FACE);  // cloth is two-sided
   glDisable(GL_BLEND);
 
-  // Shadow pass.
+  // Shadow pass, its depths pushed back by their slope: with the normal offset below, a crease
+  // facing away from the light is not striped by its own shadow.
   glBindFramebuffer(GL_FRAMEBUFFER, r.shadowFramebuffer);
   r.resizeShadowMap(options.shadowMapSize);
   glViewport(0, 0, r.shadowMapSize, r.shadowMapSize);
   glClear(GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.5f, 2.0f);
   glUseProgram(r.shadowProgram);
   setMatrix(r.shadowProgram, "lightViewProjection", lightViewProjection);
   for (const GpuCloth& gpu : r.cloths) {
@@ -446,6 +524,9 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
     glBindVertexArray(r.colliderVao);
     glDrawElements(GL_TRIANGLES, colliderIndexCount, GL_UNSIGNED_INT, nullptr);
   }
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  // Two shadow-map texels of the light's box: how far off the surface shadows are looked up.
+  const auto shadowNormalOffset = static_cast<float>(2.0 * 2.0 * radius / r.shadowMapSize);
 
   // Main pass, multisampled when the context can.
   const double aspect = static_cast<double>(width) / height;
@@ -465,22 +546,32 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   const glm::vec3 middle(static_cast<float>(camera.target.x), 0.0f, static_cast<float>(camera.target.z));
   const glm::vec3 quad[4] = {middle + glm::vec3{-extent, 0, -extent}, middle + glm::vec3{extent, 0, -extent},
                              middle + glm::vec3{-extent, 0, extent}, middle + glm::vec3{extent, 0, extent}};
-  glUseProgram(r.groundProgram);
-  setMatrix(r.groundProgram, "viewProjection", viewProjection);
-  setMatrix(r.groundProgram, "lightViewProjection", lightViewProjection);
-  setVec3(r.groundProgram, "lightDirection", towardsLight);
-  setVec3(r.groundProgram, "eyePosition", eye);
-  setVec3(r.groundProgram, "backgroundColour", options.backgroundColour);
-  glUniform1i(uniform(r.groundProgram, "shadowMap"), 0);
-  glUniform1i(uniform(r.groundProgram, "shadowRadius"), std::clamp(options.shadowSoftness, 0, 3));
-  glBindVertexArray(r.groundVao);
-  glBindBuffer(GL_ARRAY_BUFFER, r.groundBuffer);
-  glBufferSubData(GL_ARRAY_BUFFER, 0, sizeof quad, quad);
-  // The table sits a hair below y = 0 so cloth lying on it is never hidden by it.
-  glEnable(GL_POLYGON_OFFSET_FILL);
-  glPolygonOffset(1.0f, 1.0f);
-  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-  glDisable(GL_POLYGON_OFFSET_FILL);
+  // Attributes a drawing does not stream keep one value for the whole draw (not the VAO's state
+  // in GL: set here, before each kind of drawing that relies on them).
+  glVertexAttrib3f(1, 0.0f, 1.0f, 0.0f);
+  glVertexAttrib1f(2, 0.0f);
+  glVertexAttrib2f(3, 0.0f, 0.0f);
+  // The table, only where the world has one: a scene without it is not drawn standing on a floor
+  // that a cloth would fall through.
+  if (hasTable(world)) {
+    glUseProgram(r.groundProgram);
+    setMatrix(r.groundProgram, "viewProjection", viewProjection);
+    setMatrix(r.groundProgram, "lightViewProjection", lightViewProjection);
+    setVec3(r.groundProgram, "lightDirection", towardsLight);
+    glUniform1f(uniform(r.groundProgram, "shadowNormalOffset"), 0.0f);
+    setVec3(r.groundProgram, "eyePosition", eye);
+    setVec3(r.groundProgram, "backgroundColour", options.backgroundColour);
+    glUniform1i(uniform(r.groundProgram, "shadowMap"), 0);
+    glUniform1i(uniform(r.groundProgram, "shadowRadius"), std::clamp(options.shadowSoftness, 0, 3));
+    glBindVertexArray(r.groundVao);
+    glBindBuffer(GL_ARRAY_BUFFER, r.groundBuffer);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, sizeof quad, quad);
+    // The table sits a hair below y = 0 so cloth lying on it is never hidden by it.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.0f, 1.0f);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+  }
 
   glUseProgram(r.clothProgram);
   setMatrix(r.clothProgram, "viewProjection", viewProjection);
@@ -493,9 +584,11 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glUniform1f(uniform(r.clothProgram, "strainScale"), std::max(1e-6f, options.strainScale));
   glUniform1i(uniform(r.clothProgram, "shadowMap"), 0);
   glUniform1i(uniform(r.clothProgram, "shadowRadius"), std::clamp(options.shadowSoftness - 1, 0, 2));
+  glUniform1f(uniform(r.clothProgram, "shadowNormalOffset"), shadowNormalOffset);
   if (colliderIndexCount > 0) {
     glUniform1i(uniform(r.clothProgram, "twoSided"), 0);
     glUniform1i(uniform(r.clothProgram, "strainMap"), 0);
+    glUniform1i(uniform(r.clothProgram, "woven"), 0);
     setVec3(r.clothProgram, "frontColour", options.colliderColour);
     glBindVertexArray(r.colliderVao);
     glDrawElements(GL_TRIANGLES, colliderIndexCount, GL_UNSIGNED_INT, nullptr);
@@ -503,11 +596,18 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
     glUniform1i(uniform(r.clothProgram, "strainMap"), options.strainMap ? 1 : 0);
   }
   glUniform1i(uniform(r.clothProgram, "twoSided"), 1);
+  glUniform1i(uniform(r.clothProgram, "woven"), options.woven ? 1 : 0);
+  // Under a wireframe the surface sits a hair back, so its edges are not lost in it.
+  if (options.wireframe) {
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.0f, 1.0f);
+  }
   for (const GpuCloth& gpu : r.cloths) {
     if (gpu.triangleIndexCount == 0) continue;
     glBindVertexArray(gpu.vao);
     glDrawElements(GL_TRIANGLES, gpu.triangleIndexCount, GL_UNSIGNED_INT, nullptr);
   }
+  glDisable(GL_POLYGON_OFFSET_FILL);
 
   // Chains, pins and the overlay.
   glUseProgram(r.overlayProgram);
@@ -515,12 +615,27 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glEnable(GL_PROGRAM_POINT_SIZE);
   glUniform1i(uniform(r.overlayProgram, "roundPoints"), 0);
   for (const GpuCloth& gpu : r.cloths) {
-    if (gpu.lineIndexCount == 0) continue;
+    if (gpu.lineIndexCount == 0 || !(gpu.chain || options.wireframe)) continue;
+    if (gpu.chain) {
+      glVertexAttrib4f(1, 0.15f, 0.15f, 0.18f, 1.0f);
+    } else {
+      glVertexAttrib4f(1, 0.08f, 0.08f, 0.10f, 1.0f);
+    }
     glBindVertexArray(gpu.lineVao);
     glDrawElements(GL_LINES, gpu.lineIndexCount, GL_UNSIGNED_INT, nullptr);
   }
   const float pixelsPerMetre =
       static_cast<float>(height / (2.0 * std::tan(camera.fieldOfView / 2.0) * camera.distance));
+  if (options.particles) {  // every particle of a sheet as a dot, a few pixels wide
+    glUniform1i(uniform(r.overlayProgram, "roundPoints"), 1);
+    glUniform1f(uniform(r.overlayProgram, "pointSize"), 5.0f);
+    glVertexAttrib4f(1, 0.95f, 0.95f, 0.95f, 1.0f);
+    for (const GpuCloth& gpu : r.cloths) {
+      if (gpu.chain) continue;
+      glBindVertexArray(gpu.lineVao);
+      glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(gpu.particles));
+    }
+  }
   r.overlayScratch.clear();
   for (const sim::Cloth& cloth : world.cloths()) {
     if (!cloth.rest.triangles.empty()) continue;  // beads of a chain
@@ -533,7 +648,10 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
 
   glDisable(GL_DEPTH_TEST);  // markers stay visible through the cloth
   glUniform1i(uniform(r.overlayProgram, "roundPoints"), 0);
+  glEnable(GL_BLEND);  // a line's alpha fades it (a cut's seam)
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   r.drawOverlay(overlay.lines, GL_LINES);
+  glDisable(GL_BLEND);
   r.overlayScratch.clear();
   if (options.showPins) {
     for (const sim::Cloth& cloth : world.cloths()) {

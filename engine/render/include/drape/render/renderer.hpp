@@ -2,9 +2,11 @@
 // it a get-proc-address function, and the same code draws in a window and off-screen.
 //
 // What it draws: each cloth as a smooth two-sided lit surface (normals recomputed every frame, a
-// front and a back colour, optionally a strain colour map); a chain as links and beads; the table
-// (y = 0) with a soft shadow of the cloth; colliders as grey solids; pins as round markers; and an overlay of finger
-// rings and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry. Positions and
+// front and a back colour with a woven gingham printed in the cloth's rest coordinates, or a
+// strain colour map; optionally its triangles' edges and its particles); a chain as links and
+// beads; the table (y = 0), where the world has one, with a soft shadow of the cloth; colliders as
+// grey solids inside the cloth's thickness; pins as round markers; and an overlay of finger rings
+// and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry. Positions and
 // normals stream every frame into buffers allocated once; index buffers are re-uploaded only when the world's topology
 // version changes.
 #pragma once
@@ -50,6 +52,9 @@ struct FrameOptions {
   bool strainMap = false;     // colour by stretch instead of the front/back colours
   float strainScale = 0.10f;  // strain shown fully red
   bool showPins = true;
+  bool woven = true;        // a gingham check and a weave printed on the cloth (not with strainMap)
+  bool wireframe = false;   // the triangles' edges over the surface
+  bool particles = false;   // every particle as a dot
   bool multisample = true;   // 4x MSAA when the context has it
   int shadowSoftness = 3;    // 0..3: shadow filter taps (2s+1)^2 on the table; a software renderer pays for each
   int shadowMapSize = 2048;  // texels a side, 256..4096
@@ -58,6 +63,10 @@ struct FrameOptions {
   glm::vec3 backgroundColour{0.62f, 0.66f, 0.70f};
   glm::vec3 colliderColour{0.55f, 0.56f, 0.60f};
 };
+
+// The strain colour map, as shaders/cloth.frag computes it (keep the two the same): blue at rest,
+// green at a third of `scale`, yellow at two thirds, red at `scale` and beyond; for legends.
+glm::vec3 strainColour(float strain, float scale);
 
 class Renderer {
  public:
