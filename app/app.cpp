@@ -230,6 +230,8 @@ KeyAction keyAction(SDL_Keycode key, bool ctrl) {
     case SDLK_ESCAPE: return KeyAction::askQuit;
     case SDLK_f: return KeyAction::frame;
     case SDLK_HOME: return KeyAction::resetView;
+    case SDLK_w: return KeyAction::edges;
+    case SDLK_c: return KeyAction::strain;
     default: return KeyAction::none;
   }
 }
@@ -420,6 +422,7 @@ int runApp(const AppOptions& options) {
         }
       }
       session->keepCameraAboveTable();
+      session->ageSeams(replay ? session->world().settings().solver.dt : elapsed);
 
       if (replay) replay->afterEvents(*session, *input);
 

@@ -13,7 +13,7 @@ namespace drape::app {
 inline constexpr int kExitNoDisplay = 4;
 
 struct AppOptions {
-  std::string scene = "hang";                   // a scene (path or shipped name) or a snapshot (*.drape.json)
+  std::string scene = "desk";                   // a scene (path or shipped name) or a snapshot (*.drape.json)
   std::optional<std::string> replay;            // gesture script, pushed through SDL as touch events
   std::optional<std::string> record;            // write what the fingers did here at exit
   std::optional<std::int64_t> screenshotAfter;  // frames

@@ -8,7 +8,7 @@
 int main(int argc, char** argv) {
   drape::app::AppOptions options;
   CLI::App cli{"drape: an interactive cloth simulator you touch"};
-  cli.add_option("scene", options.scene, "Scene file, shipped scene name, or snapshot (*.drape.json); default hang");
+  cli.add_option("scene", options.scene, "Scene file, shipped scene name, or snapshot (*.drape.json); default desk");
   cli.add_option("--replay", options.replay, "Play this gesture script as touch events pushed through SDL");
   cli.add_option("--record", options.record, "At exit, write what the fingers did as a gesture script");
   std::vector<std::string> screenshot;

@@ -30,6 +30,7 @@ const char* const kHelp[][2] = {
     {"F / Home", "frame the cloth / the view the scene starts with"},
     {"1 / 2 / 3", "Sticky / Cut / Create mode"},
     {"V", "fingers move in the table plane or the view plane"},
+    {"W / C", "the triangles' edges / strain colours, on or off"},
     {"Space / N", "pause / one step while paused"},
     {"R", "reset the scene (the camera stays)"},
     {"U or Ctrl+Z", "undo the last drawn cloth or cut"},
@@ -153,6 +154,43 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
   ImGui::End();
 }
 
+// The strain colours' legend, at the bottom left while they are on: the bar from rest to the
+// scale the View panel sets, read in per cent of a link's rest length.
+void strainLegend(PanelState& panels) {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  const float scale = panels.frameOptions.strainScale;
+  ImGui::SetNextWindowPos(ImVec2(10.0f, display.y - 10.0f), ImGuiCond_Always, ImVec2(0.0f, 1.0f));
+  ImGui::SetNextWindowBgAlpha(0.55f);
+  ImGui::Begin("Strain", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav);
+  noteWindow(panels);
+  ImGui::Text("stretch of the longest link at each particle");
+  const float width = std::min(260.0f, std::max(120.0f, display.x * 0.25f)), height = 14.0f;
+  const ImVec2 at = ImGui::GetCursorScreenPos();
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  constexpr int kSteps = 32;
+  for (int i = 0; i < kSteps; ++i) {
+    const auto colour = [&](int k) {
+      const glm::vec3 c = render::strainColour(scale * static_cast<float>(k) / kSteps, scale);
+      return ImGui::GetColorU32(ImVec4(c.r, c.g, c.b, 1.0f));
+    };
+    const float x0 = at.x + width * static_cast<float>(i) / kSteps, x1 = at.x + width * static_cast<float>(i + 1) / kSteps;
+    draw->AddRectFilledMultiColor(ImVec2(x0, at.y), ImVec2(x1, at.y + height), colour(i), colour(i + 1), colour(i + 1),
+                                  colour(i));
+  }
+  ImGui::Dummy(ImVec2(width, height));
+  ImGui::Text("0 %%");
+  char label[32];
+  std::snprintf(label, sizeof label, "%.3g %%", scale * 50.0);
+  ImGui::SameLine(width * 0.5f - ImGui::CalcTextSize(label).x * 0.5f + ImGui::GetStyle().WindowPadding.x);
+  ImGui::TextUnformatted(label);
+  std::snprintf(label, sizeof label, "%.3g %% and more", scale * 100.0);
+  ImGui::SameLine(std::max(width - ImGui::CalcTextSize(label).x + ImGui::GetStyle().WindowPadding.x, 0.0f));
+  ImGui::TextUnformatted(label);
+  ImGui::End();
+}
+
 void help(PanelState& panels) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(display.x * 0.5f, display.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
@@ -218,6 +256,8 @@ void applyKey(KeyAction action, Session& session, PanelState& panels) {
     case KeyAction::load: session.load(panels.file); break;
     case KeyAction::frame: session.frameCloths(); break;
     case KeyAction::resetView: session.resetView(); break;
+    case KeyAction::edges: panels.frameOptions.wireframe = !panels.frameOptions.wireframe; break;
+    case KeyAction::strain: panels.frameOptions.strainMap = !panels.frameOptions.strainMap; break;
     case KeyAction::step: session.paused = true; break;  // the app takes the step
     case KeyAction::none:
     case KeyAction::screenshot:
@@ -253,6 +293,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   panels.windows.clear();
   hud(session, panels, stats);
   if (panels.showHelp) help(panels);
+  if (panels.frameOptions.strainMap) strainLegend(panels);
   if (!panels.showPanels) {
     panels.panelWidth = 0.0f;
     return toLoad;
@@ -466,7 +507,23 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   if (changed) session.tune(tuned);
 
   if (ImGui::CollapsingHeader("View")) {
+    ImGui::Checkbox("woven", &panels.frameOptions.woven);
+    tip("a gingham check and a plain weave printed on the cloth: they stretch and shear with it");
+    ImGui::SameLine();
+    ImGui::Checkbox("edges", &panels.frameOptions.wireframe);
+    tip("the triangles' edges over the surface (W)");
+    ImGui::SameLine();
+    ImGui::Checkbox("particles", &panels.frameOptions.particles);
+    tip("every particle as a dot");
     ImGui::Checkbox("strain colours", &panels.frameOptions.strainMap);
+    tip("colour by stretch: each particle shows its longest structural link's strain (C)");
+    if (panels.frameOptions.strainMap) {
+      float percent = panels.frameOptions.strainScale * 100.0f;
+      if (ImGui::SliderFloat("red at (%)", &percent, 0.5f, 100.0f, "%.1f", ImGuiSliderFlags_Logarithmic)) {
+        panels.frameOptions.strainScale = std::clamp(percent, 0.5f, 100.0f) / 100.0f;
+      }
+      tip("the stretch shown fully red; the legend at the bottom left reads the colours");
+    }
     ImGui::Checkbox("pins", &panels.frameOptions.showPins);
     ImGui::Checkbox("antialiasing (4x MSAA)", &panels.frameOptions.multisample);
     ImGui::SliderInt("shadow softness", &panels.frameOptions.shadowSoftness, 0, 3);
@@ -542,6 +599,11 @@ OutlineSize outlineSize(const std::vector<glm::dvec3>& stroke, double spacing) {
 
 render::Overlay fingerOverlay(Session& session, const InputMapper& input) {
   render::Overlay overlay;
+  // A cut just made: its path in red, fading out.
+  for (const Session::Seam& seam : session.seams()) {
+    const auto alpha = static_cast<float>(std::clamp(1.0 - seam.age / Session::kSeamSeconds, 0.0, 1.0));
+    overlay.addStroke(seam.path, glm::vec4{0.95f, 0.15f, 0.1f, alpha});
+  }
   const interact::Interaction& interaction = session.interaction();
   for (const interact::TouchView& touch : interaction.touches()) {
     if (touch.mode == interact::Mode::sticky) {

@@ -30,6 +30,8 @@ enum class KeyAction : std::uint8_t {
   load,
   frame,      // F: the cloths fill the view
   resetView,  // Home: the camera as the scene starts
+  edges,      // W: the triangles' edges on or off
+  strain,     // C: strain colours on or off
   askQuit,    // Esc: quits when pressed twice
   quit
 };

@@ -56,13 +56,40 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
   interaction_->cutNothing = [this] {
     if (!undo_.empty() && undo_.back().kind == Undo::Kind::cut) undo_.pop_back();
   };
+  interaction_->afterCut = [this](const std::vector<sim::Vec3>& cutPath) { seams_.push_back({cutPath, 0.0}); };
   interaction_->afterSpawn = [this] { undo_.push_back({Undo::Kind::spawn, {}}); };
   interaction_->tell = [this](const std::string& line) { status = line; };
   undo_.clear();
+  seams_.clear();
+  shape_.clear();
+  shapeVersion_ = 0;
   resetView();
 }
 
 namespace {
+
+// `before` (the cloths as a cut or tear found them) with the motion since, from `now`: a cut or
+// tear keeps each particle's index and appends its copies (topology.cpp), so the first particles
+// of each cloth now are the particles before it, where they are now. Positions, previous positions
+// (so velocities), velocities and pins come from now; rest data and masses from before, so the
+// mass is exactly what it was. Where the cloths do not match so (a cloth fewer), `before` as it is.
+std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const std::vector<sim::Cloth>& now) {
+  if (before.size() != now.size()) return before;
+  for (std::size_t c = 0; c < before.size(); ++c) {
+    if (now[c].state.position.size() < before[c].state.position.size()) return before;
+  }
+  for (std::size_t c = 0; c < before.size(); ++c) {
+    sim::ParticleState& s = before[c].state;
+    const sim::ParticleState& current = now[c].state;
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+      s.position[i] = current.position[i];
+      s.previousPosition[i] = current.previousPosition[i];
+      if (i < s.velocity.size() && i < current.velocity.size()) s.velocity[i] = current.velocity[i];
+      s.pinned[i] = current.pinned[i];
+    }
+  }
+  return before;
+}
 
 constexpr double kYaw = 0.6, kPitch = 0.45;  // from the front right, a little above
 
@@ -250,7 +277,24 @@ std::optional<std::string> Session::tune(const sim::WorldSettings& settings) {
 
 sim::StepStatus Session::step() {
   interaction_->update(world_->settings().solver.dt);
+  const bool tearing = world_->settings().tearing.enabled;
+  const std::uint64_t version = world_->topologyVersion();
+  if (tearing && version != shapeVersion_) {
+    shape_ = world_->cloths();
+    shapeVersion_ = version;
+  }
   const sim::StepStatus result = world_->step();
+  if (tearing && world_->topologyVersion() != version && result == sim::StepStatus::ok) {
+    // Torn in this step. A tear running on (within half a second of its last step) stays one undo.
+    const double now = world_->time();
+    if (!undo_.empty() && undo_.back().kind == Undo::Kind::tear && now - undo_.back().time < 0.5) {
+      undo_.back().time = now;
+    } else {
+      undo_.push_back({Undo::Kind::tear, std::move(shape_), now});
+    }
+    shape_.clear();
+    shapeVersion_ = 0;
+  }
   if (result == sim::StepStatus::diverged) {
     const sim::Divergence d = *world_->divergence();
     status = "diverged at step " + std::to_string(d.step) + " (cloth " + std::to_string(d.cloth) + " particle " +
@@ -275,10 +319,16 @@ bool Session::undo() {
     status = "took back the last drawn cloth";
   } else {
     interaction_->cancelAll();
-    world_->restoreCloths(std::move(last.cloths));
-    status = "took back the last cut";
+    world_->restoreCloths(withMotionSince(std::move(last.cloths), world_->cloths()));
+    status = last.kind == Undo::Kind::cut ? "took back the last cut" : "took back the last tear";
   }
+  shapeVersion_ = 0;
   return true;
+}
+
+void Session::ageSeams(double seconds) {
+  for (Seam& seam : seams_) seam.age += std::isfinite(seconds) ? std::max(seconds, 0.0) : 0.0;
+  std::erase_if(seams_, [](const Seam& seam) { return seam.age > kSeamSeconds; });
 }
 
 }  // namespace drape::app

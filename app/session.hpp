@@ -61,8 +61,22 @@ class Session {
   // positions, at rest, and the session pauses and says so in `status`.
   sim::StepStatus step();
 
-  // Takes back the last cloth drawn or the last cut. False when there is nothing to take back.
+  // Takes back the last cloth drawn, the last cut or the last tear (a tear that runs on over
+  // several steps is one). A cut or tear is taken back with the motion since: every particle it
+  // left in place stays where it is now, the copies it made are dropped, and the masses are as
+  // before it. False when there is nothing to take back.
   bool undo();
+
+  // Cuts just made, shown as seams for a moment (kSeamSeconds), so a cut is seen before a half
+  // is lifted.
+  struct Seam {
+    std::vector<glm::dvec3> path;  // m
+    double age = 0.0;              // s since the cut
+  };
+  static constexpr double kSeamSeconds = 1.5;
+  const std::vector<Seam>& seams() const { return seams_; }
+  // Ages the seams by `seconds` of wall time and forgets those older than kSeamSeconds.
+  void ageSeams(double seconds);
 
   // The window the camera draws into: its aspect, and the fraction of its width the panels cover
   // on the right. Framing centres the scene in the part left uncovered.
@@ -91,8 +105,9 @@ class Session {
 
  private:
   struct Undo {
-    enum class Kind : std::uint8_t { spawn, cut } kind;
-    std::vector<sim::Cloth> cloths;  // cut: the cloths before it
+    enum class Kind : std::uint8_t { spawn, cut, tear } kind;
+    std::vector<sim::Cloth> cloths;  // cut, tear: the cloths before it
+    double time = 0.0;               // tear: the world's time when it last tore on
   };
   void adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const std::filesystem::path& path);
   void frame(glm::dvec3 lower, glm::dvec3 upper, double yaw, double pitch);
@@ -103,6 +118,11 @@ class Session {
   std::unique_ptr<interact::Interaction> interaction_;
   render::Camera camera_;
   std::vector<Undo> undo_;
+  std::vector<Seam> seams_;
+  // While tearing is on: the cloths as their topology stood before the step (copied once after
+  // each change of it), for undoing a tear.
+  std::vector<sim::Cloth> shape_;
+  std::uint64_t shapeVersion_ = 0;
   int threads_ = 1;
   double viewAspect_ = 16.0 / 10.0;
   double viewCovered_ = 0.0;

@@ -252,6 +252,78 @@ TEST(Session, UndoTakesBackACutAndADrawnCloth) {
   EXPECT_FALSE(session.undo());
 }
 
+// Sum of every particle's mass, in index order.
+double totalMass(const Session& session) {
+  double mass = 0.0;
+  for (const sim::Cloth& cloth : session.world().cloths()) {
+    for (const sim::MassReal m : cloth.state.mass) mass += m;
+  }
+  return mass;
+}
+
+TEST(Session, UndoingACutKeepsTheMotionSinceAndTheMassAndTheCutShowsAsASeamForAMoment) {
+  Session session("desk");
+  const double mass = totalMass(session);
+  interact::Interaction& hand = session.interaction();
+  hand.setMode(interact::Mode::cut);
+  ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.5, 0.0, 0.0})));
+  ASSERT_TRUE(hand.move(1, interact::Pointer::at({0.5, 0.0, 0.01})));
+  EXPECT_TRUE(session.seams().empty());  // while the swipe goes on, its stroke shows
+  ASSERT_TRUE(hand.up(1));
+  ASSERT_EQ(session.seams().size(), 1u);
+  EXPECT_EQ(session.seams()[0].path.size(), 2u);
+  ASSERT_GT(session.world().cloths()[0].state.position.size(), 576u);
+  // Drag the near half 20 cm along x.
+  hand.setMode(interact::Mode::sticky);
+  ASSERT_TRUE(hand.down(2, interact::Pointer::at({0.0, 0.0, 0.15})));
+  for (int i = 1; i <= 20; ++i) {
+    ASSERT_TRUE(hand.move(2, interact::Pointer::at({0.01 * i, 0.0, 0.15})));
+    session.step();
+  }
+  ASSERT_TRUE(hand.up(2));
+  session.step();
+  const std::vector<sim::Vec3> moved = session.world().cloths()[0].state.position;
+  ASSERT_TRUE(session.undo());
+  const sim::Cloth& cloth = session.world().cloths()[0];
+  ASSERT_EQ(cloth.state.position.size(), 576u);
+  EXPECT_EQ(cloth.pieceCount, 1u);
+  for (std::size_t i = 0; i < 576; ++i) ASSERT_EQ(cloth.state.position[i], moved[i]) << i;
+  EXPECT_GT(cloth.state.position[cloth.rest.index(12, 20)].x, -0.3 + 0.6 * 12.0 / 23.0 + 0.1);  // still dragged
+  EXPECT_EQ(totalMass(session), mass);
+  // The seam fades in a second and a half of the app's time.
+  session.ageSeams(1.0);
+  EXPECT_EQ(session.seams().size(), 1u);
+  session.ageSeams(1.0);
+  EXPECT_TRUE(session.seams().empty());
+}
+
+TEST(Session, ATearRunningOverManyStepsIsUndoneAsOneWithTheMotionSince) {
+  Session session("desk-tear");
+  const double mass = totalMass(session);
+  interact::Interaction& hand = session.interaction();
+  ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.2, 0.0, 0.0})));
+  ASSERT_TRUE(hand.down(2, interact::Pointer::at({0.2, 0.0, 0.0})));
+  int steps = 0;
+  for (; steps < 120 && session.world().cloths()[0].topology.torn < 20; ++steps) {
+    ASSERT_TRUE(hand.move(1, interact::Pointer::at({-0.2 - 0.01 * steps, 0.0, 0.0})));
+    ASSERT_TRUE(hand.move(2, interact::Pointer::at({0.2 + 0.01 * steps, 0.0, 0.0})));
+    session.step();
+  }
+  ASSERT_GE(session.world().cloths()[0].topology.torn, 20u) << "it never tore";
+  ASSERT_TRUE(hand.up(1));
+  ASSERT_TRUE(hand.up(2));
+  const std::vector<sim::Vec3> now = session.world().cloths()[0].state.position;
+  ASSERT_TRUE(session.undo());
+  EXPECT_EQ(session.status, "took back the last tear");
+  const sim::Cloth& cloth = session.world().cloths()[0];
+  ASSERT_EQ(cloth.state.position.size(), 576u);
+  EXPECT_EQ(cloth.topology.torn, 0u);
+  EXPECT_EQ(cloth.pieceCount, 1u);
+  for (std::size_t i = 0; i < 576; ++i) ASSERT_EQ(cloth.state.position[i], now[i]) << i;
+  EXPECT_EQ(totalMass(session), mass);
+  EXPECT_FALSE(session.undo());  // the tear was one
+}
+
 TEST(Session, SaveAndLoadBringBackATornClothExactly) {
   Session session("desk");
   interact::Interaction& hand = session.interaction();

@@ -224,6 +224,7 @@ bool Interaction::up(int id) {
   note(GestureEvent::Type::up, id);
   if (lifted.mode == Mode::sticky && lifted.holds) world_.releaseFinger(id);
   if (lifted.mode == Mode::cut && lifted.cutStarted && !lifted.cutSomething && cutNothing) cutNothing();
+  if (lifted.mode == Mode::cut && lifted.cutSomething && afterCut) afterCut(lifted.stroke);
   if (lifted.mode == Mode::create) return spawn(lifted);
   return true;
 }

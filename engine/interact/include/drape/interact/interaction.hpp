@@ -121,6 +121,9 @@ class Interaction {
   // and when the stroke ends having cut nothing, so the snapshot can be dropped.
   std::function<void()> beforeCut;
   std::function<void()> cutNothing;
+  // Called when a cut stroke that cut something lifts, with its path (m, on the table or the view
+  // plane): the app shows it as a seam for a moment.
+  std::function<void(const std::vector<Vec3>&)> afterCut;
   // Called when a drawn cloth has been added to the world.
   std::function<void()> afterSpawn;
   // Called with a line worth showing the user when a drawn outline lifts: the cloth it made (its
