@@ -57,7 +57,7 @@ std::size_t compare(const Image& actual, const Image& expected, Image& diff) {
 }
 
 // Share of strongly coloured pixels: the table and the sky are near grey, the cloth (either side,
-// or its strain colours) is saturated.
+// or its strain colours) is saturated, but for the gingham's white squares.
 double clothShare(const Image& image) {
   std::size_t coloured = 0;
   for (std::size_t i = 0; i < image.rgba.size(); i += 4) {
