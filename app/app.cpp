@@ -6,9 +6,12 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include <backends/imgui_impl_opengl3.h>
@@ -115,17 +118,41 @@ class TouchReplay {
                                                : session.camera().project(action.pointer.world, aspect);
       using T = interact::GestureEvent::Type;
       const T type = action.onTheWay ? T::move : e.type;
+      // A world point (and a down's radius) travels beside its touch event, so the finger goes
+      // exactly where drape-cli replay puts it; such a point is replayed even where the camera
+      // cannot see it. A screen point is seen through the script's camera (the interaction's aspect
+      // is the script's while it plays).
+      const bool world = action.pointer.kind == interact::Pointer::Kind::world;
+      const Beside beside{world ? std::optional(action.pointer.world) : std::nullopt,
+                          type == T::down ? e.radius : std::nullopt};
       switch (type) {
         case T::down:
         case T::move:
-          if (at) pushTouch(window, type == T::down ? SDL_FINGERDOWN : SDL_FINGERMOTION, e.finger, *at);
+          if (at || world) {
+            pushTouch(window, type == T::down ? SDL_FINGERDOWN : SDL_FINGERMOTION, e.finger, at.value_or(glm::dvec2{0.5}));
+            beside_[e.finger].push_back(beside);
+          }
           break;
-        case T::up: pushTouch(window, SDL_FINGERUP, e.finger, at.value_or(glm::dvec2{0.5})); break;
+        case T::up:
+          pushTouch(window, SDL_FINGERUP, e.finger, at.value_or(glm::dvec2{0.5}));
+          beside_[e.finger].push_back({});
+          break;
         default: break;
       }
       // Everything in order: what has no touch event waits until the touches before it are handled.
       pending_.push_back(action);
     }
+  }
+
+  // What the script said of the oldest replayed touch event of `finger` still in SDL's queue, that
+  // a touch event cannot carry: its world point and its radius (events of one finger come out of
+  // the queue in the order they went in).
+  void completeTouch(std::int64_t finger, InputEvent& event) {
+    std::deque<Beside>& queue = beside_[finger];
+    if (queue.empty()) return;
+    event.world = queue.front().world;
+    event.radius = queue.front().radius;
+    queue.pop_front();
   }
 
   // After SDL's queue (and with it the touches pushed above) has been handled.
@@ -157,6 +184,11 @@ class TouchReplay {
   interact::GestureScript script_;
   interact::ReplayClock clock_;
   std::vector<interact::ReplayAction> pending_;
+  struct Beside {
+    std::optional<interact::Vec3> world;
+    std::optional<double> radius;
+  };
+  std::map<std::int64_t, std::deque<Beside>> beside_;
 };
 
 InputEvent mouseEvent(InputEvent::Kind kind, int x, int y, const WindowSize& size) {
@@ -268,7 +300,8 @@ int runApp(const AppOptions& options) {
   try {
     session = std::make_unique<Session>(options.scene);
     // Every core steps the world (up to 8; the picture is the same bit for bit with one).
-    session->setThreads(static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u)));
+    session->setThreads(options.threads ? *options.threads
+                                        : static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 8u)));
     if (options.replay) script = scene::loadGesture(*options.replay);
   } catch (const scene::InputError& error) {
     std::cerr << "drape: error: " << error.what() << "\n";
@@ -376,7 +409,10 @@ int runApp(const AppOptions& options) {
       const double elapsed = std::chrono::duration<double>(now - last).count();
       last = now;
       WindowSize size = sizeOf(window);
-      session->interaction().setCamera(session->camera(), size.aspect());
+      // Screen points of a script with a camera are points of its picture, at its aspect.
+      session->interaction().setCamera(session->camera(), replay && replay->script().camera
+                                                              ? replay->script().aspect
+                                                              : size.aspect());
       if (replay) replay->beforeStep(window, *session, size.aspect());
 
       bool stepOnce = false;
@@ -407,7 +443,10 @@ int runApp(const AppOptions& options) {
           remap();
         }
         size = sizeOf(window);
-        if (const std::optional<InputEvent> input_event = translate(event, size)) {
+        if (std::optional<InputEvent> input_event = translate(event, size)) {
+          if (replay && touch && event.tfinger.touchId == kReplayTouch) {
+            replay->completeTouch(event.tfinger.fingerId, *input_event);
+          }
           // Over a panel as the panels were last drawn, for this event where it is now (the wheel's
           // own event has no position: the pointer's is taken); touches always reach the cloth.
           double x = input_event->x, y = input_event->y;

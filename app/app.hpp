@@ -22,6 +22,7 @@ struct AppOptions {
   std::optional<std::string> out;         // final state (JSON) at exit, as drape-cli run --out
   int width = 1280;
   int height = 800;
+  std::optional<int> threads;  // simulation threads; by default every core (at most 8)
 };
 
 int runApp(const AppOptions& options);

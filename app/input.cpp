@@ -48,7 +48,8 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
   using Kind = InputEvent::Kind;
   forgetLifted();
   const auto key = std::make_pair(event.touch, event.finger);
-  const interact::Pointer pointer = interact::Pointer::onScreen(event.x, event.y);
+  const interact::Pointer pointer =
+      event.world ? interact::Pointer::at(*event.world) : interact::Pointer::onScreen(event.x, event.y);
   switch (event.kind) {
     case Kind::touchDown: {
       if (!finite(event.x, event.y)) return report("a touch at a point that is not finite");
@@ -59,7 +60,7 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
       }
       const int id = nextTouchId_;
       nextTouchId_ = nextTouchId_ + 1 < kMouseIds ? nextTouchId_ + 1 : 1;
-      if (!interaction_.down(id, pointer)) return report("touch: " + interaction_.lastError());
+      if (!interaction_.down(id, pointer, event.radius)) return report("touch: " + interaction_.lastError());
       touchIds_[key] = id;
       return;
     }

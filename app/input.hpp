@@ -33,6 +33,11 @@ struct InputEvent {
   bool shift = false;
   bool ctrl = false;
   double wheel = 0.0;  // notches, positive away from the user
+  // A replayed script's touch at a world point (m): the finger goes there as drape-cli replay
+  // puts it, not through the screen and back onto the finger's plane, which would lose a point's
+  // height above the table. Real touches have none.
+  std::optional<interact::Vec3> world;
+  std::optional<double> radius;  // a replayed down's own finger radius (m), as the script gave it
 };
 
 struct InputOptions {

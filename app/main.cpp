@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   cli.add_option("--out", options.out, "At exit, write the final state (JSON, as drape-cli run --out)");
   cli.add_option("--width", options.width, "Window width in points")->check(CLI::Range(64, 16384));
   cli.add_option("--height", options.height, "Window height in points")->check(CLI::Range(64, 16384));
+  cli.add_option("--threads", options.threads, "Simulation threads (default: every core, at most 8)")
+      ->check(CLI::Range(1, 8));
   try {
     cli.parse(argc, argv);
     if (!screenshot.empty()) {
