@@ -525,7 +525,11 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       tip("the stretch shown fully red; the legend at the bottom left reads the colours");
     }
     ImGui::Checkbox("pins", &panels.frameOptions.showPins);
-    ImGui::Checkbox("antialiasing (4x MSAA)", &panels.frameOptions.multisample);
+    ImGui::Checkbox("FXAA", &panels.frameOptions.fxaa);
+    tip("cheap antialiasing: one filter pass over the picture that softens the cloth's stair-stepped edges");
+    ImGui::SameLine();
+    ImGui::Checkbox("4x MSAA", &panels.frameOptions.multisample);
+    tip("true antialiasing, four samples a pixel: costly on a software renderer (replaces FXAA while on)");
     ImGui::SliderInt("shadow softness", &panels.frameOptions.shadowSoftness, 0, 3);
     ImGui::SliderInt("shadow map", &panels.frameOptions.shadowMapSize, 256, 4096);
   }

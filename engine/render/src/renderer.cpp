@@ -4,9 +4,11 @@
 #include <glad/gl.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <string_view>
 
 #include <glm/geometric.hpp>
@@ -19,7 +21,8 @@
 namespace drape::render {
 
 namespace shaders {
-extern const std::string_view cloth_vert, cloth_frag, ground_frag, shadow_vert, shadow_frag, overlay_vert, overlay_frag;
+extern const std::string_view cloth_vert, cloth_frag, ground_frag, shadow_vert, shadow_frag, overlay_vert, overlay_frag,
+    fxaa_vert, fxaa_frag;
 }
 
 namespace {
@@ -141,6 +144,43 @@ std::vector<std::uint32_t> triangleEdges(const std::vector<glm::uvec3>& triangle
   return pairs;
 }
 
+// The pixels (x, y, width, height from the bottom left) that the box around the cloths and the
+// finite colliders covers in the picture, a pixel wider each way: FXAA looks for edges there only.
+// The whole picture where a corner is behind the eye.
+std::array<int, 4> coveredPixels(const sim::World& world, const Camera& camera, int width, int height) {
+  glm::dvec3 lower{std::numeric_limits<double>::max()}, upper{std::numeric_limits<double>::lowest()};
+  for (const sim::Cloth& cloth : world.cloths()) {
+    for (const sim::Vec3& x : cloth.state.position) {
+      lower = glm::min(lower, x);
+      upper = glm::max(upper, x);
+    }
+  }
+  glm::dvec3 collidersLower, collidersUpper;
+  sceneBounds(world, collidersLower, collidersUpper);  // cloths, finite colliders and the table's height
+  if (world.colliders().size() > 0) {
+    lower = glm::min(lower, collidersLower);
+    upper = glm::max(upper, collidersUpper);
+  }
+  const std::array<int, 4> whole{0, 0, width, height};
+  if (!(lower.x <= upper.x)) return whole;
+  const double aspect = static_cast<double>(width) / height;
+  double left = 1.0, right = 0.0, top = 1.0, bottom = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 p{corner & 1 ? upper.x : lower.x, corner & 2 ? upper.y : lower.y, corner & 4 ? upper.z : lower.z};
+    const std::optional<glm::dvec2> at = camera.project(p, aspect);
+    if (!at) return whole;
+    left = std::min(left, at->x);
+    right = std::max(right, at->x);
+    top = std::min(top, at->y);
+    bottom = std::max(bottom, at->y);
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor(left * width)) - 2, 0, width);
+  const int x1 = std::clamp(static_cast<int>(std::ceil(right * width)) + 2, 0, width);
+  const int y0 = std::clamp(static_cast<int>(std::floor((1.0 - bottom) * height)) - 2, 0, height);
+  const int y1 = std::clamp(static_cast<int>(std::ceil((1.0 - top) * height)) + 2, 0, height);
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
 // The level plane through the origin is the table the renderer draws (collider_geometry.hpp).
 bool hasTable(const sim::World& world) {
   return std::any_of(world.colliders().begin(), world.colliders().end(), [](const sim::Collider& c) {
@@ -208,7 +248,10 @@ void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) 
 }
 
 struct Renderer::Impl {
-  GLuint clothProgram = 0, groundProgram = 0, shadowProgram = 0, overlayProgram = 0;
+  GLuint clothProgram = 0, groundProgram = 0, shadowProgram = 0, overlayProgram = 0, fxaaProgram = 0;
+  // FXAA: the scene is drawn into this picture (and depth), then filtered into the caller's framebuffer.
+  GLuint pictureFramebuffer = 0, pictureColour = 0, pictureDepth = 0, fullScreenVao = 0;
+  int pictureWidth = 0, pictureHeight = 0;
   GLuint shadowFramebuffer = 0, shadowTexture = 0;
   GLuint sampleFramebuffer = 0, sampleColour = 0, sampleDepth = 0;
   int sampleWidth = 0, sampleHeight = 0, samples = 0;
@@ -348,6 +391,35 @@ struct Renderer::Impl {
     sampleHeight = height;
   }
 
+  // False where the context cannot make the picture (then the frame is drawn without FXAA).
+  bool ensurePictureTarget(int width, int height) {
+    if (width == pictureWidth && height == pictureHeight) return pictureFramebuffer != 0;
+    if (!pictureFramebuffer) {
+      glGenFramebuffers(1, &pictureFramebuffer);
+      glGenTextures(1, &pictureColour);
+      glGenRenderbuffers(1, &pictureDepth);
+    }
+    glBindTexture(GL_TEXTURE_2D, pictureColour);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindRenderbuffer(GL_RENDERBUFFER, pictureDepth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, pictureFramebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, pictureColour, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, pictureDepth);
+    const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    pictureWidth = width;
+    pictureHeight = height;
+    if (!complete) {
+      glDeleteFramebuffers(1, &pictureFramebuffer);
+      pictureFramebuffer = 0;
+    }
+    return complete;
+  }
+
   void drawOverlay(const std::vector<OverlayVertex>& vertices, GLenum mode) {
     if (vertices.empty()) return;
     glBindVertexArray(overlayVao);
@@ -375,6 +447,8 @@ Renderer::Renderer(GetProcAddress getProcAddress) : impl_(std::make_unique<Impl>
   r.groundProgram = link(shaders::cloth_vert, shaders::ground_frag, "ground");
   r.shadowProgram = link(shaders::shadow_vert, shaders::shadow_frag, "shadow");
   r.overlayProgram = link(shaders::overlay_vert, shaders::overlay_frag, "overlay");
+  r.fxaaProgram = link(shaders::fxaa_vert, shaders::fxaa_frag, "fxaa");
+  glGenVertexArrays(1, &r.fullScreenVao);
 
   // Shadow map: a depth texture compared in hardware, filtered linearly (then PCF in the shader).
   glGenTextures(1, &r.shadowTexture);
@@ -441,7 +515,13 @@ Renderer::Renderer(GetProcAddress getProcAddress) : impl_(std::make_unique<Impl>
 Renderer::~Renderer() {
   Impl& r = *impl_;
   r.releaseCloths();
-  for (GLuint program : {r.clothProgram, r.groundProgram, r.shadowProgram, r.overlayProgram}) glDeleteProgram(program);
+  for (GLuint program : {r.clothProgram, r.groundProgram, r.shadowProgram, r.overlayProgram, r.fxaaProgram}) {
+    glDeleteProgram(program);
+  }
+  glDeleteFramebuffers(1, &r.pictureFramebuffer);
+  glDeleteTextures(1, &r.pictureColour);
+  glDeleteRenderbuffers(1, &r.pictureDepth);
+  glDeleteVertexArrays(1, &r.fullScreenVao);
   glDeleteFramebuffers(1, &r.shadowFramebuffer);
   glDeleteTextures(1, &r.shadowTexture);
   glDeleteFramebuffers(1, &r.sampleFramebuffer);
@@ -528,12 +608,15 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   // Two shadow-map texels of the light's box: how far off the surface shadows are looked up.
   const auto shadowNormalOffset = static_cast<float>(2.0 * 2.0 * radius / r.shadowMapSize);
 
-  // Main pass, multisampled when the context can.
+  // Main pass, multisampled when the context can, or into a picture FXAA filters afterwards.
   const double aspect = static_cast<double>(width) / height;
   const glm::mat4 viewProjection = camera.projection(aspect) * camera.view();
   const bool multisample = options.multisample && r.samples > 0;
   if (multisample) r.ensureSampleTarget(width, height);
-  glBindFramebuffer(GL_FRAMEBUFFER, multisample && r.samples > 0 ? r.sampleFramebuffer : static_cast<GLuint>(target));
+  const bool fxaa = !(multisample && r.samples > 0) && options.fxaa && r.ensurePictureTarget(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, multisample && r.samples > 0 ? r.sampleFramebuffer
+                                    : fxaa                       ? r.pictureFramebuffer
+                                                                 : static_cast<GLuint>(target));
   glViewport(0, 0, width, height);
   glClearColor(options.backgroundColour.r, options.backgroundColour.g, options.backgroundColour.b, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -672,6 +755,29 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r.sampleFramebuffer);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  if (fxaa) {
+    // The picture into the caller's framebuffer, then filtered over the part of it the cloths and
+    // colliders cover (elsewhere are the table and the sky: no edges, and a full-picture pass costs
+    // about 20 ms a frame at 1280 x 800 on llvmpipe).
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r.pictureFramebuffer);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target));
+    glViewport(0, 0, width, height);
+    const std::array<int, 4> covered = coveredPixels(world, camera, width, height);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(covered[0], covered[1], covered[2], covered[3]);
+    glDisable(GL_DEPTH_TEST);
+    glUseProgram(r.fxaaProgram);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, r.pictureColour);
+    glUniform1i(uniform(r.fxaaProgram, "picture"), 0);
+    glUniform2f(uniform(r.fxaaProgram, "texel"), 1.0f / static_cast<float>(width), 1.0f / static_cast<float>(height));
+    glBindVertexArray(r.fullScreenVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisable(GL_SCISSOR_TEST);
+    glEnable(GL_DEPTH_TEST);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target));
   glBindVertexArray(0);

@@ -6,9 +6,10 @@
 // strain colour map; optionally its triangles' edges and its particles); a chain as links and
 // beads; the table (y = 0), where the world has one, with a soft shadow of the cloth; colliders as
 // grey solids inside the cloth's thickness; pins as round markers; and an overlay of finger rings
-// and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry. Positions and
-// normals stream every frame into buffers allocated once; index buffers are re-uploaded only when the world's topology
-// version changes.
+// and strokes. Frames are multisampled and resolved into the framebuffer that was bound on entry,
+// or, without multisampling, drawn into a picture that FXAA filters into it. Positions and normals
+// stream every frame into buffers allocated once; index buffers are re-uploaded only when the
+// world's topology version changes.
 #pragma once
 
 #include <cstdint>
@@ -56,6 +57,7 @@ struct FrameOptions {
   bool wireframe = false;   // the triangles' edges over the surface
   bool particles = false;   // every particle as a dot
   bool multisample = true;   // 4x MSAA when the context has it
+  bool fxaa = true;          // without MSAA: FXAA, one cheap filter pass over the picture
   int shadowSoftness = 3;    // 0..3: shadow filter taps (2s+1)^2 on the table; a software renderer pays for each
   int shadowMapSize = 2048;  // texels a side, 256..4096
   glm::vec3 frontColour{0.85f, 0.33f, 0.18f};
