@@ -246,7 +246,8 @@ KeyAction keyAction(SDL_Keycode key, bool ctrl) {
     case SDLK_PERIOD: return KeyAction::step;
     case SDLK_r: return KeyAction::reset;
     case SDLK_u: return KeyAction::undo;
-    case SDLK_z: return ctrl ? KeyAction::undo : KeyAction::none;
+    case SDLK_z: return ctrl ? ((SDL_GetModState() & KMOD_SHIFT) != 0 ? KeyAction::redo : KeyAction::undo) : KeyAction::none;
+    case SDLK_y: return ctrl ? KeyAction::redo : KeyAction::none;
     case SDLK_p:
     case SDLK_F12: return KeyAction::screenshot;
     case SDLK_1: return KeyAction::sticky;

@@ -33,7 +33,8 @@ const char* const kHelp[][2] = {
     {"W / C", "the triangles' edges / strain colours, on or off"},
     {"Space / N", "pause / one step while paused"},
     {"R", "reset the scene (the camera stays)"},
-    {"U or Ctrl+Z", "undo the last drawn cloth or cut"},
+    {"U or Ctrl+Z", "undo the last drawn cloth, cut or tear"},
+    {"Ctrl+Y or Ctrl+Shift+Z", "redo what undo took back"},
     {"P or F12", "screenshot (drape-screenshot-NNN.png)"},
     {"Ctrl+S / Ctrl+O", "save / load the file named in the panel"},
     {"Tab / H or F1", "hide the panels / this help"},
@@ -238,6 +239,7 @@ void applyKey(KeyAction action, Session& session, PanelState& panels) {
     case KeyAction::pause: session.paused = !session.paused; break;
     case KeyAction::reset: session.reset(); break;
     case KeyAction::undo: session.undo(); break;
+    case KeyAction::redo: session.redo(); break;
     case KeyAction::sticky: session.interaction().setMode(interact::Mode::sticky); break;
     case KeyAction::cut: session.interaction().setMode(interact::Mode::cut); break;
     case KeyAction::create: session.interaction().setMode(interact::Mode::create); break;
@@ -358,6 +360,13 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::SameLine();
     if (ImGui::Button("undo")) session.undo();
     ImGui::SameLine();
+    if (ImGui::Button("redo")) session.redo();
+    // Only beside the rest where the panel is wide enough.
+    const ImGuiStyle& style = ImGui::GetStyle();
+    if (ImGui::GetItemRectMax().x + style.ItemSpacing.x + ImGui::CalcTextSize("screenshot").x + 2.0f * style.FramePadding.x <
+        ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) {
+      ImGui::SameLine();
+    }
     if (ImGui::Button("screenshot")) panels.wantScreenshot = true;
     // Every sheet made of a fabric in physical units (docs/fabric.md), or as the scene says.
     const std::string fabric = session.fabric().empty() ? "as the scene says" : session.fabric();

@@ -19,6 +19,7 @@ enum class KeyAction : std::uint8_t {
   step,
   reset,
   undo,
+  redo,
   screenshot,
   sticky,
   cut,

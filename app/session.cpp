@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <array>
 #include <limits>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -52,14 +54,21 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
   fabric_.clear();
   interaction_ = std::make_unique<interact::Interaction>(*world_);
   interaction_->settings().material = scene::drawnClothTemplate(scene_);
-  interaction_->beforeCut = [this] { undo_.push_back({Undo::Kind::cut, world_->cloths()}); };
+  interaction_->beforeCut = [this] {
+    undo_.push_back({Undo::Kind::cut, world_->cloths()});
+    redo_.clear();
+  };
   interaction_->cutNothing = [this] {
     if (!undo_.empty() && undo_.back().kind == Undo::Kind::cut) undo_.pop_back();
   };
   interaction_->afterCut = [this](const std::vector<sim::Vec3>& cutPath) { seams_.push_back({cutPath, 0.0}); };
-  interaction_->afterSpawn = [this] { undo_.push_back({Undo::Kind::spawn, {}}); };
+  interaction_->afterSpawn = [this] {
+    undo_.push_back({Undo::Kind::spawn, {}});
+    redo_.clear();
+  };
   interaction_->tell = [this](const std::string& line) { status = line; };
   undo_.clear();
+  redo_.clear();
   seams_.clear();
   shape_.clear();
   shapeVersion_ = 0;
@@ -89,6 +98,42 @@ std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const st
     }
   }
   return before;
+}
+
+// `after` (the cloths as an undo found them, a cut or tear in them) brought to the motion since,
+// from `now` (the cloths before that cut or tear): each particle that was there before it is where
+// it is now, and each copy the cut or tear made keeps its offset from its particle (a copy has its
+// particle's rest position, bit for bit: ClothRest::duplicateRestPosition). Where the cloths do not
+// match so, `after` as it is.
+std::vector<sim::Cloth> withMotionAfter(std::vector<sim::Cloth> after, const std::vector<sim::Cloth>& now) {
+  if (after.size() != now.size()) return after;
+  for (std::size_t c = 0; c < after.size(); ++c) {
+    if (after[c].state.position.size() < now[c].state.position.size()) return after;
+  }
+  for (std::size_t c = 0; c < after.size(); ++c) {
+    sim::ParticleState& s = after[c].state;
+    const sim::ParticleState& current = now[c].state;
+    const std::vector<glm::vec3>& rest = after[c].rest.restOffsets;
+    const std::size_t n = current.position.size();
+    std::map<std::array<float, 3>, std::size_t> particleAt;
+    for (std::size_t i = 0; i < n; ++i) particleAt.emplace(std::array<float, 3>{rest[i].x, rest[i].y, rest[i].z}, i);
+    const std::vector<sim::Vec3> position = s.position, previous = s.previousPosition;
+    for (std::size_t j = n; j < s.position.size(); ++j) {
+      const auto found = particleAt.find({rest[j].x, rest[j].y, rest[j].z});
+      if (found == particleAt.end()) continue;
+      const std::size_t i = found->second;
+      s.position[j] = current.position[i] + (position[j] - position[i]);
+      s.previousPosition[j] = current.previousPosition[i] + (previous[j] - previous[i]);
+      if (j < s.velocity.size() && i < current.velocity.size()) s.velocity[j] = current.velocity[i];
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      s.position[i] = current.position[i];
+      s.previousPosition[i] = current.previousPosition[i];
+      if (i < s.velocity.size() && i < current.velocity.size()) s.velocity[i] = current.velocity[i];
+      s.pinned[i] = current.pinned[i];
+    }
+  }
+  return after;
 }
 
 constexpr double kYaw = 0.6, kPitch = 0.45;  // from the front right, a little above
@@ -292,6 +337,7 @@ sim::StepStatus Session::step() {
     } else {
       undo_.push_back({Undo::Kind::tear, std::move(shape_), now});
     }
+    redo_.clear();
     shape_.clear();
     shapeVersion_ = 0;
   }
@@ -313,14 +359,40 @@ bool Session::undo() {
   }
   Undo last = std::move(undo_.back());
   undo_.pop_back();
+  interaction_->cancelAll();
   if (last.kind == Undo::Kind::spawn) {
-    interaction_->cancelAll();
+    const std::optional<int> index = interaction_->lastSpawned();
+    if (index) redo_.push_back({Undo::Kind::spawn, {world_->cloths()[static_cast<std::size_t>(*index)]}});
     interaction_->undoSpawn();
     status = "took back the last drawn cloth";
   } else {
-    interaction_->cancelAll();
+    redo_.push_back({last.kind, world_->cloths()});
     world_->restoreCloths(withMotionSince(std::move(last.cloths), world_->cloths()));
     status = last.kind == Undo::Kind::cut ? "took back the last cut" : "took back the last tear";
+  }
+  shapeVersion_ = 0;
+  return true;
+}
+
+bool Session::redo() {
+  if (redo_.empty()) {
+    status = "nothing to redo";
+    return false;
+  }
+  Undo next = std::move(redo_.back());
+  redo_.pop_back();
+  interaction_->cancelAll();
+  if (next.kind == Undo::Kind::spawn) {
+    std::vector<sim::Cloth> cloths = world_->cloths();
+    cloths.push_back(std::move(next.cloths.front()));
+    world_->restoreCloths(std::move(cloths));
+    interaction_->noteSpawned(static_cast<int>(world_->cloths().size()) - 1);
+    undo_.push_back({Undo::Kind::spawn, {}});
+    status = "put back the drawn cloth";
+  } else {
+    undo_.push_back({next.kind, world_->cloths(), world_->time()});
+    world_->restoreCloths(withMotionAfter(std::move(next.cloths), world_->cloths()));
+    status = next.kind == Undo::Kind::cut ? "did the cut again" : "did the tear again";
   }
   shapeVersion_ = 0;
   return true;

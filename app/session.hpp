@@ -75,6 +75,11 @@ class Session {
   };
   static constexpr double kSeamSeconds = 1.5;
   const std::vector<Seam>& seams() const { return seams_; }
+  // Does again what the last undo took back (a drawn cloth comes back as it was; a cut or tear
+  // comes back with the motion since: each copy it made is where it was beside its particle).
+  // Any new cloth, cut or tear forgets what could be redone. False when there is nothing.
+  bool redo();
+
   // Ages the seams by `seconds` of wall time and forgets those older than kSeamSeconds.
   void ageSeams(double seconds);
 
@@ -118,6 +123,7 @@ class Session {
   std::unique_ptr<interact::Interaction> interaction_;
   render::Camera camera_;
   std::vector<Undo> undo_;
+  std::vector<Undo> redo_;  // spawn: the cloth taken back; cut, tear: the cloths as the undo found them
   std::vector<Seam> seams_;
   // While tearing is on: the cloths as their topology stood before the step (copied once after
   // each change of it), for undoing a tear.

@@ -324,6 +324,64 @@ TEST(Session, ATearRunningOverManyStepsIsUndoneAsOneWithTheMotionSince) {
   EXPECT_FALSE(session.undo());  // the tear was one
 }
 
+TEST(Session, RedoPutsBackACutWithTheMotionSinceAndADrawnClothAsItWas) {
+  Session session("desk");
+  const double mass = totalMass(session);
+  interact::Interaction& hand = session.interaction();
+  EXPECT_FALSE(session.redo());
+  hand.setMode(interact::Mode::cut);
+  ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.5, 0.0, 0.0})));
+  ASSERT_TRUE(hand.move(1, interact::Pointer::at({0.5, 0.0, 0.01})));
+  ASSERT_TRUE(hand.up(1));
+  for (int i = 0; i < 5; ++i) session.step();
+  const std::size_t cutParticles = session.world().cloths()[0].state.position.size();
+  ASSERT_GT(cutParticles, 576u);
+  ASSERT_TRUE(session.undo());
+  // Carry the whole cloth 10 cm along x, then redo: the cut comes back where the cloth is now.
+  std::vector<sim::Cloth> moved = session.world().cloths();
+  for (sim::Vec3& x : moved[0].state.position) x.x += 0.1;
+  for (sim::Vec3& x : moved[0].state.previousPosition) x.x += 0.1;
+  session.world().restoreCloths(std::move(moved));
+  const std::vector<sim::Vec3> before = session.world().cloths()[0].state.position;
+  ASSERT_TRUE(session.redo());
+  const sim::Cloth& cut = session.world().cloths()[0];
+  ASSERT_EQ(cut.state.position.size(), cutParticles);
+  EXPECT_EQ(cut.pieceCount, 2u);
+  EXPECT_EQ(totalMass(session), mass);
+  for (std::size_t i = 0; i < 576; ++i) ASSERT_EQ(cut.state.position[i], before[i]);
+  // Every copy lies beside its particle (the cut had barely opened), not 10 cm behind it.
+  for (std::size_t j = 576; j < cutParticles; ++j) {
+    double nearest = 1e9;
+    for (std::size_t i = 0; i < 576; ++i) nearest = std::min(nearest, glm::length(cut.state.position[j] - before[i]));
+    EXPECT_LT(nearest, 0.01) << j;
+  }
+  EXPECT_FALSE(session.redo());
+  ASSERT_TRUE(session.undo());  // the cut again
+  EXPECT_EQ(session.world().cloths()[0].state.position.size(), 576u);
+  // A drawn cloth: taken back, put back, and taken back again.
+  hand.setMode(interact::Mode::create);
+  ASSERT_TRUE(hand.down(2, interact::Pointer::at({0.5, 0.0, 0.5})));
+  for (const sim::Vec3 p : {sim::Vec3{0.8, 0.0, 0.5}, sim::Vec3{0.8, 0.0, 0.8}, sim::Vec3{0.5, 0.0, 0.8}}) {
+    ASSERT_TRUE(hand.move(2, interact::Pointer::at(p)));
+  }
+  ASSERT_TRUE(hand.up(2));
+  ASSERT_EQ(session.world().cloths().size(), 2u);
+  const std::size_t drawn = session.world().cloths()[1].state.position.size();
+  ASSERT_TRUE(session.undo());
+  EXPECT_EQ(session.world().cloths().size(), 1u);
+  ASSERT_TRUE(session.redo());
+  ASSERT_EQ(session.world().cloths().size(), 2u);
+  EXPECT_EQ(session.world().cloths()[1].state.position.size(), drawn);
+  ASSERT_TRUE(session.undo());
+  EXPECT_EQ(session.world().cloths().size(), 1u);
+  // Something new forgets the redo.
+  hand.setMode(interact::Mode::cut);
+  ASSERT_TRUE(hand.down(3, interact::Pointer::at({-0.5, 0.0, 0.1})));
+  ASSERT_TRUE(hand.move(3, interact::Pointer::at({0.5, 0.0, 0.1})));
+  ASSERT_TRUE(hand.up(3));
+  EXPECT_FALSE(session.redo());
+}
+
 TEST(Session, SaveAndLoadBringBackATornClothExactly) {
   Session session("desk");
   interact::Interaction& hand = session.interaction();

@@ -136,6 +136,12 @@ class Interaction {
   const std::string& lastError() const { return lastError_; }
   std::vector<TouchView> touches() const;
   int spawnedCount() const { return static_cast<int>(spawnedIndex_.size()); }
+  // The world's index of the most recently drawn cloth still in it (what undoSpawn would take).
+  std::optional<int> lastSpawned() const {
+    return spawnedIndex_.empty() ? std::nullopt : std::optional<int>(spawnedIndex_.back());
+  }
+  // Records the cloth at `index` as the most recently drawn one (a drawn cloth put back by a redo).
+  void noteSpawned(int index) { spawnedIndex_.push_back(index); }
 
  private:
   struct Touch {
