@@ -417,6 +417,8 @@ int runApp(const AppOptions& options) {
       if (replay) replay->beforeStep(window, *session, size.aspect());
 
       bool stepOnce = false;
+      const InputMapper* mapperBefore = input.get();
+      const std::int64_t fingerMovesBefore = input->fingerMoves();
       SDL_Event event;
       while (SDL_PollEvent(&event)) {
         const bool touch = event.type == SDL_FINGERDOWN || event.type == SDL_FINGERMOTION || event.type == SDL_FINGERUP;
@@ -468,7 +470,10 @@ int runApp(const AppOptions& options) {
 
       // Simulate: whole steps at the scene's dt, paced by the wall clock (one per frame in a replay).
       const double dt = session->world().settings().solver.dt;
-      int steps = replay ? 1 : session->paused ? (stepOnce ? 1 : 0) : stepper.advance(elapsed, dt);
+      // While paused, a step each frame a finger moved: a drag is not lost, the cloth follows the
+      // hand and stops when it stops.
+      const bool handMoved = input.get() == mapperBefore && input->fingerMoves() != fingerMovesBefore;
+      int steps = replay ? 1 : session->paused ? (stepOnce || handMoved ? 1 : 0) : stepper.advance(elapsed, dt);
       if (session->paused) stepper.reset();
       const Clock::time_point simStart = Clock::now();
       for (int i = 0; i < steps; ++i) {

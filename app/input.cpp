@@ -29,7 +29,7 @@ double InputMapper::liftPerNotch() const {
 
 void InputMapper::liftBy(int id, double& height, double notches) {
   height = std::max(0.0, height + notches * liftPerNotch());
-  interaction_.lift(id, height);
+  if (interaction_.lift(id, height)) ++fingerMoves_;
 }
 
 void InputMapper::forgetLifted() {
@@ -68,7 +68,7 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
       const auto found = touchIds_.find(key);
       if (found == touchIds_.end()) return;  // a touch that began on no finger (or was lifted): nothing to move
       if (!finite(event.x, event.y)) return report("a touch moved to a point that is not finite");
-      interaction_.move(found->second, pointer);
+      if (interaction_.move(found->second, pointer)) ++fingerMoves_;
       return;
     }
     case Kind::touchUp: {
@@ -124,7 +124,7 @@ void InputMapper::handle(const InputEvent& event, bool uiWantsMouse) {
       lastX_ = event.x;
       lastY_ = event.y;
       if (drag_ == Drag::finger) {
-        interaction_.move(dragFinger_, pointer);
+        if (interaction_.move(dragFinger_, pointer)) ++fingerMoves_;
       } else if (drag_ == Drag::orbit) {
         camera_.orbit(dx * options_.orbitSpeed, dy * options_.orbitSpeed);
       } else if (drag_ == Drag::pan) {

@@ -82,6 +82,9 @@ class InputMapper {
   bool parked(int id) const;    // a Shift-parked mouse finger
   double liftPerNotch() const;  // m a wheel notch lifts, now
   bool dragging() const { return drag_ != Drag::none; }
+  // How many times a finger was moved or lifted (touch, mouse or wheel) so far: while the world is
+  // paused, the app steps it once for each frame in which this grew, so the cloth follows the hand.
+  std::int64_t fingerMoves() const { return fingerMoves_; }
   // Events that could not be honoured (an up for a touch that is not down), newest last.
   const std::vector<std::string>& problems() const { return problems_; }
 
@@ -112,6 +115,7 @@ class InputMapper {
   double lastX_ = 0.0, lastY_ = 0.0;
   std::vector<Parked> parked_;
   std::vector<std::string> problems_;
+  std::int64_t fingerMoves_ = 0;
 };
 
 }  // namespace drape::app

@@ -146,6 +146,37 @@ TEST_F(App, AMouseDragWithXdotoolMovesTheCloth) {
   EXPECT_GT(middle(state(file("dragged.json"))) - middle(state(file("still.json"))), 0.05);
 }
 
+TEST_F(App, ADragWhilePausedIsNotLostTheClothFollowsTheHandAndStopsWithIt) {
+  // Paused at once (Space), then the same drag: the world steps only in frames where the finger
+  // moved, so the cloth comes along, and the time stops again when the hand does.
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk --width 640 --height 400 --exit-after 2000 --out dragged.json &\n"
+      "app=$!\n"
+      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
+      "[ -n \"$window\" ]\n"
+      "sleep 1\n"
+      "xdotool key --window $window space\n"
+      "sleep 0.5\n"
+      "xdotool mousemove --window $window 320 200 mousedown 1\n"
+      "for x in 340 360 380 400 420 440 460; do sleep 0.2; xdotool mousemove --window $window $x 200; done\n"
+      "sleep 0.5\n"
+      "xdotool mouseup 1\n"
+      "sleep 1\n"
+      "xdotool key --window $window Escape\n"
+      "sleep 0.3\n"
+      "xdotool key --window $window Escape\n"
+      "wait $app");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const json dragged = state(file("dragged.json"));
+  double x = 0.0;
+  for (const json& p : dragged["cloths"][0]["positions"]) x += p[0].get<double>();
+  x /= static_cast<double>(dragged["cloths"][0]["positions"].size());
+  EXPECT_GT(x, 0.05);  // it lay centred on x = 0
+  // A step a moved frame, and a second and a half of waiting paused: well under the 4 s it ran.
+  EXPECT_LT(dragged["time"].get<double>(), 2.0);
+  EXPECT_GT(dragged["time"].get<double>(), 0.0);
+}
+
 TEST_F(App, ResizingAndMinimisingDoNotStopIt) {
   const Result result = inDisplay(
       "\"$DRAPE\" desk --width 640 --height 400 --exit-after 100000 --out state.json &\n"
