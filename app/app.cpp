@@ -430,7 +430,9 @@ int runApp(const AppOptions& options) {
         if (event.type == SDL_KEYDOWN && !ImGui::GetIO().WantCaptureKeyboard) {
           const KeyAction action = keyAction(event.key.keysym.sym, (event.key.keysym.mod & KMOD_CTRL) != 0);
           if (action == KeyAction::quit) running = false;
-          if (action == KeyAction::askQuit) {
+          if (action == KeyAction::askQuit && ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopup)) {
+            panels.closePopups = true;  // Esc closes an open list first, and does not count towards quitting
+          } else if (action == KeyAction::askQuit) {
             // Esc twice within 3 s: one stray press does not throw away drawn cloths and cuts.
             const Clock::time_point pressed = Clock::now();
             if (quitAsked && pressed - *quitAsked < std::chrono::seconds(3)) {
@@ -492,11 +494,13 @@ int runApp(const AppOptions& options) {
                          fingerOverlay(*session, *input));
         renderer->finish();
         const Clock::time_point panelStart = Clock::now();
-        stats.sceneSeconds = std::chrono::duration<double>(panelStart - drawStart).count();
+        // Shown from the next frame, with the other parts of this one (the HUD is drawn below).
+        const double sceneSeconds = std::chrono::duration<double>(panelStart - drawStart).count();
         ImGui_ImplOpenGL3_NewFrame();
         imguiMouse.newFrame(window, size, elapsed);
         ImGui::NewFrame();
         const std::optional<std::filesystem::path> toLoad = drawPanels(*session, panels, stats, *input);
+        stats.sceneSeconds = sceneSeconds;
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
         session->setView(size.aspect(), size.width > 0 ? panels.panelWidth / static_cast<float>(size.width) : 0.0);

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <imgui.h>
+#include <imgui_internal.h>  // ClosePopupsExceptModals: Esc closes an open list
 
 #include "drape/scene/fabric.hpp"
 #include "drape/sim/intersections.hpp"
@@ -37,7 +38,7 @@ const char* const kHelp[][2] = {
     {"Ctrl+Y or Ctrl+Shift+Z", "redo what undo took back"},
     {"P or F12", "screenshot (drape-screenshot-NNN.png)"},
     {"Ctrl+S / Ctrl+O", "save / load the file named in the panel"},
-    {"Tab / H or F1", "hide the panels / this help"},
+    {"Tab / H or F1", "hide the panels and the HUD (a clean view) / this help"},
     {"Esc twice or Ctrl+Q", "quit"},
 };
 
@@ -84,7 +85,14 @@ void noteWindow(PanelState& panels) {
                             (at.y + size.y) / display.y});
 }
 
-const char* modeHint(interact::Mode mode) {
+const char* modeHint(interact::Mode mode, bool small) {
+  if (small) {
+    switch (mode) {
+      case interact::Mode::sticky: return "drag the cloth; right drag orbits";
+      case interact::Mode::cut: return "swipe across the cloth to cut it";
+      case interact::Mode::create: return "draw an outline on the table";
+    }
+  }
   switch (mode) {
     case interact::Mode::sticky:
       return "Sticky: drag the cloth with the left button or a finger (Shift leaves the finger down, the wheel "
@@ -125,11 +133,28 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
   const double fps = stats.frameSeconds > 0.0 ? 1.0 / stats.frameSeconds : 0.0;
   ImGui::Text("%s   %.0f fps   t = %.2f s%s", session.scene().name.c_str(), fps, session.world().time(),
               session.paused ? "   PAUSED" : "");
+  // First what the mode does and the keys of the first minute (a small window shows only these,
+  // shorter, the status, and what is being drawn), then the detail.
+  const bool small = display.x < 640.0f || display.y < 420.0f;
+  ImGui::TextColored(ImVec4(0.7f, 0.9f, 1.0f, 1.0f), "%s", modeHint(interaction.mode(), small));
+  ImGui::TextColored(ImVec4(0.85f, 0.85f, 0.85f, 1.0f), "1 sticky  2 cut  3 create   F frame   Home view   F1 all keys");
+  for (const interact::TouchView& touch : interaction.touches()) {
+    if (touch.mode != interact::Mode::create) continue;
+    const OutlineSize size = outlineSize(touch.stroke, interaction.settings().spacing);
+    ImGui::Text("outline %.2f m x %.2f m: about %.0f particles at %.0f mm", size.width, size.depth, size.particles,
+                1000.0 * interaction.settings().spacing);
+  }
+  if (!session.status.empty()) ImGui::TextWrapped("%s", session.status.c_str());
+  if (small) {
+    ImGui::PopTextWrapPos();
+    ImGui::End();
+    return;
+  }
   ImGui::Text("mode: %s (%s plane)   fingers: %zu", std::string(interact::name(interaction.mode())).c_str(),
               std::string(interact::name(interaction.settings().plane)).c_str(), session.world().fingers().size());
   ImGui::Text("simulation %.1f ms (%d steps), drawing %.1f ms per frame", stats.simulationSeconds * 1e3, stats.steps,
               stats.drawSeconds * 1e3);
-  if (display.x >= 1000.0f) {  // the detail, where there is room for it
+  if (display.x >= 1000.0f) {  // the detail, where there is room for it (the parts of the same frame)
     ImGui::Text("  drawing: scene %.1f ms, panels %.1f ms, presenting %.1f ms", stats.sceneSeconds * 1e3,
                 stats.panelSeconds * 1e3, stats.swapSeconds * 1e3);
   }
@@ -141,16 +166,6 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
                        simulation ? " (fewer iterations or substeps, or a smaller cloth)" : "");
   }
   if (stats.fellBehind) ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "slower than real time");
-  if (!session.status.empty()) ImGui::TextWrapped("%s", session.status.c_str());
-  // What the mode does, and what is being drawn: the size the cloth would be.
-  ImGui::TextColored(ImVec4(0.7f, 0.9f, 1.0f, 1.0f), "%s", modeHint(interaction.mode()));
-  for (const interact::TouchView& touch : interaction.touches()) {
-    if (touch.mode != interact::Mode::create) continue;
-    const OutlineSize size = outlineSize(touch.stroke, interaction.settings().spacing);
-    ImGui::Text("outline %.2f m x %.2f m: about %.0f particles at %.0f mm", size.width, size.depth, size.particles,
-                1000.0 * interaction.settings().spacing);
-  }
-  ImGui::TextDisabled("1 sticky  2 cut  3 create   F frame   Home view   F1 all keys");
   ImGui::PopTextWrapPos();
   ImGui::End();
 }
@@ -195,15 +210,19 @@ void strainLegend(PanelState& panels) {
 void help(PanelState& panels) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(display.x * 0.5f, display.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
-  ImGui::Begin("Help", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings);
+  // On a small window it keeps inside it: the descriptions wrap, and it scrolls.
+  const float width = std::min(display.x - 20.0f, ImGui::GetFontSize() * 52.0f);
+  ImGui::SetNextWindowSize(ImVec2(std::max(width, 100.0f), 0.0f), ImGuiCond_Always);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f), ImVec2(display.x - 20.0f, std::max(display.y - 20.0f, 60.0f)));
+  ImGui::Begin("Help", nullptr, ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
   noteWindow(panels);
-  if (ImGui::BeginTable("bindings", 2)) {
+  if (ImGui::BeginTable("bindings", 2, ImGuiTableFlags_SizingStretchProp)) {
     for (const auto& row : kHelp) {
       ImGui::TableNextRow();
       ImGui::TableNextColumn();
       ImGui::TextUnformatted(row[0]);
       ImGui::TableNextColumn();
-      ImGui::TextUnformatted(row[1]);
+      ImGui::TextWrapped("%s", row[1]);
     }
     ImGui::EndTable();
   }
@@ -293,13 +312,18 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   }
 
   panels.windows.clear();
+  if (panels.closePopups) {  // Esc with a list open closes the list (and does not count towards quitting)
+    ImGui::ClosePopupsExceptModals();
+    panels.closePopups = false;
+  }
+  if (!panels.showPanels) {  // Tab: a clean view of the scene, no HUD, no panel
+    panels.panelWidth = 0.0f;
+    if (panels.showHelp) help(panels);
+    return toLoad;
+  }
   hud(session, panels, stats);
   if (panels.showHelp) help(panels);
   if (panels.frameOptions.strainMap) strainLegend(panels);
-  if (!panels.showPanels) {
-    panels.panelWidth = 0.0f;
-    return toLoad;
-  }
 
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   // Anchored to the right edge, full height, 30 % of the window wide (230 to 380 points) and

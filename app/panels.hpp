@@ -73,6 +73,7 @@ struct PanelState {
   float lastDisplayWidth = -1.0f, lastDisplayHeight = -1.0f;  // the panel is placed again when these change
   bool collapsedBySize = false;  // the panel was collapsed because the window was too small
   bool showHelp = false;
+  bool closePopups = false;  // Esc was pressed with a list open: close it in the next frame
   bool showPanels = true;
   bool wantScreenshot = false;
   std::string file = "drape-save.drape.json";  // save and load

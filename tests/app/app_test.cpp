@@ -177,6 +177,28 @@ TEST_F(App, ADragWhilePausedIsNotLostTheClothFollowsTheHandAndStopsWithIt) {
   EXPECT_GT(dragged["time"].get<double>(), 0.0);
 }
 
+TEST_F(App, EscWithTheScenesListOpenClosesTheListAndDoesNotQuit) {
+  // The scene picker at the panel's top (the panel is 300 points wide at the right of a 1000-point
+  // window): open it and press Esc twice. The first closes the list, the second only asks: the app
+  // is still running (it used to quit); a third Esc quits.
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk --width 1000 --height 700 --exit-after 100000 &\n"
+      "app=$!\n"
+      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
+      "[ -n \"$window\" ]\n"
+      "sleep 1\n"
+      "xdotool mousemove --window $window 760 70 click 1\n"
+      "sleep 0.7\n"
+      "xdotool key --window $window Escape\n"
+      "sleep 0.5\n"
+      "xdotool key --window $window Escape\n"
+      "sleep 0.5\n"
+      "kill -0 $app\n"  // still running (set -e: the script fails here if it quit)
+      "xdotool key --window $window Escape\n"
+      "wait $app");
+  EXPECT_EQ(result.exitCode, 0) << result.err;
+}
+
 TEST_F(App, ResizingAndMinimisingDoNotStopIt) {
   const Result result = inDisplay(
       "\"$DRAPE\" desk --width 640 --height 400 --exit-after 100000 --out state.json &\n"
