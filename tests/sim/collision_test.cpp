@@ -237,6 +237,32 @@ TEST(Tunnelling, AFastDropDoesNotPassThroughAMeshShell) {
   for (const Vec3& x : world.cloths()[0].state.position) EXPECT_GT(x.y, 0.0);
 }
 
+// The mesh's grid turned a query's reach into cells through int: a reach of 1e15 m (what a particle
+// flung that far sweeps) overflowed it (UBSan: "outside the range of representable values of
+// type 'int'", found by the snapshot fuzzer), and on x86 every cell became 0, so a triangle in
+// another cell was missed. Cells are clamped to the grid first now.
+TEST(Colliders, AMeshFindsItsNearestTriangleWhateverTheReach) {
+  auto mesh = std::make_shared<TriangleMesh>();
+  // Ten small triangles in a row along x: a grid of several cells.
+  for (int i = 0; i < 10; ++i) {
+    const auto base = static_cast<std::uint32_t>(mesh->vertices.size());
+    mesh->vertices.push_back({0.1 * i, 0.0, 0.0});
+    mesh->vertices.push_back({0.1 * i + 0.05, 0.0, 0.0});
+    mesh->vertices.push_back({0.1 * i, 0.0, 0.05});
+    mesh->triangles.push_back({base, base + 1, base + 2});
+  }
+  ColliderSettings settings;
+  settings.shape = ColliderShape::mesh;
+  settings.mesh = mesh;
+  const Collider collider(settings);
+  const Vec3 aboveTheLast{0.91, 0.02, 0.01};
+  for (const Real reach : {0.1, 1e6, 1e15, 1e300}) {
+    const SurfaceDistance d = collider.distance(aboveTheLast, reach);
+    EXPECT_NEAR(d.distance, 0.02, 1e-12) << reach;
+    EXPECT_NEAR(d.normal.y, 1.0, 1e-12) << reach;
+  }
+}
+
 // Smallest distance between two particles that are far apart at rest (not neighbours).
 Real closestNonNeighbours(const Cloth& cloth, Real restApart) {
   Real closest = 1e9;

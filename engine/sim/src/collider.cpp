@@ -105,10 +105,18 @@ SurfaceDistance Collider::local(Vec3 p, Real reach) const {
               glm::abs(p - glm::clamp(p, gridOrigin_, gridOrigin_ + Vec3(gridCells_) * cellSize_)), Vec3{reach}))) {
         return best;  // the whole mesh is out of reach (tested before any conversion to int)
       }
-      const glm::ivec3 lower =
-          glm::clamp(glm::ivec3(glm::floor((p - reach - gridOrigin_) / cellSize_)), glm::ivec3(0), gridCells_ - 1);
-      const glm::ivec3 upper =
-          glm::clamp(glm::ivec3(glm::floor((p + reach - gridOrigin_) / cellSize_)), glm::ivec3(0), gridCells_ - 1);
+      // Cells clamped to the grid before they become ints: a reach of a huge motion (a particle
+      // flung 1e15 m) puts p - reach far beyond what an int holds, and a NaN goes to cell 0.
+      const auto cellOf = [&](Vec3 q) {
+        const Vec3 f = glm::floor((q - gridOrigin_) / cellSize_);
+        glm::ivec3 cell{0};
+        for (int axis = 0; axis < 3; ++axis) {
+          const double last = static_cast<double>(gridCells_[axis] - 1);
+          cell[axis] = f[axis] >= 0.0 ? static_cast<int>(std::min(f[axis], last)) : 0;
+        }
+        return cell;
+      };
+      const glm::ivec3 lower = cellOf(p - reach), upper = cellOf(p + reach);
       const TriangleMesh& mesh = *s.mesh;
       for (int z = lower.z; z <= upper.z; ++z) {
         for (int y = lower.y; y <= upper.y; ++y) {
