@@ -77,6 +77,17 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
 
 namespace {
 
+// The first n particles of `s` where they are in `current`: positions, previous positions (so
+// velocities), velocities and pins; masses stay.
+void takeMotion(sim::ParticleState& s, const sim::ParticleState& current, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    s.position[i] = current.position[i];
+    s.previousPosition[i] = current.previousPosition[i];
+    if (i < s.velocity.size() && i < current.velocity.size()) s.velocity[i] = current.velocity[i];
+    s.pinned[i] = current.pinned[i];
+  }
+}
+
 // `before` (the cloths as a cut or tear found them) with the motion since, from `now`: a cut or
 // tear keeps each particle's index and appends its copies (topology.cpp), so the first particles
 // of each cloth now are the particles before it, where they are now. Positions, previous positions
@@ -88,14 +99,7 @@ std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const st
     if (now[c].state.position.size() < before[c].state.position.size()) return before;
   }
   for (std::size_t c = 0; c < before.size(); ++c) {
-    sim::ParticleState& s = before[c].state;
-    const sim::ParticleState& current = now[c].state;
-    for (std::size_t i = 0; i < s.position.size(); ++i) {
-      s.position[i] = current.position[i];
-      s.previousPosition[i] = current.previousPosition[i];
-      if (i < s.velocity.size() && i < current.velocity.size()) s.velocity[i] = current.velocity[i];
-      s.pinned[i] = current.pinned[i];
-    }
+    takeMotion(before[c].state, now[c].state, before[c].state.position.size());
   }
   return before;
 }
@@ -126,12 +130,7 @@ std::vector<sim::Cloth> withMotionAfter(std::vector<sim::Cloth> after, const std
       s.previousPosition[j] = current.previousPosition[i] + (previous[j] - previous[i]);
       if (j < s.velocity.size() && i < current.velocity.size()) s.velocity[j] = current.velocity[i];
     }
-    for (std::size_t i = 0; i < n; ++i) {
-      s.position[i] = current.position[i];
-      s.previousPosition[i] = current.previousPosition[i];
-      if (i < s.velocity.size() && i < current.velocity.size()) s.velocity[i] = current.velocity[i];
-      s.pinned[i] = current.pinned[i];
-    }
+    takeMotion(s, current, n);
   }
   return after;
 }

@@ -116,62 +116,51 @@ TEST_F(App, AHundredFingersAtOnceAreFine) {
   }
 }
 
+// The desk in a 640 x 400 window, `first` done (keys), then a left drag from the middle 140 points
+// to the right with xdotool, and Esc twice; the state at exit is in dragged.json.
+std::string dragAcrossTheDesk(const std::string& first) {
+  return "\"$DRAPE\" desk --width 640 --height 400 --exit-after 2000 --out dragged.json &\n"
+         "app=$!\n"
+         "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
+         "[ -n \"$window\" ]\n"
+         "sleep 1\n" +
+         first +
+         "xdotool mousemove --window $window 320 200 mousedown 1\n"
+         "for x in 340 360 380 400 420 440 460; do sleep 0.2; xdotool mousemove --window $window $x 200; done\n"
+         "sleep 0.5\n"
+         "xdotool mouseup 1\n"
+         "sleep 1\n"
+         "xdotool key --window $window Escape\n"
+         "sleep 0.3\n"
+         "xdotool key --window $window Escape\n"
+         "wait $app";
+}
+
+// The mean x of the first cloth's particles.
+double middleX(const json& document) {
+  double x = 0.0;
+  const json& positions = document["cloths"][0]["positions"];
+  for (const json& p : positions) x += p[0].get<double>();
+  return x / static_cast<double>(positions.size());
+}
+
 TEST_F(App, AMouseDragWithXdotoolMovesTheCloth) {
   // Baseline: the same run without the drag.
   ASSERT_EQ(inDisplay("\"$DRAPE\" desk --width 640 --height 400 --exit-after 40 --out still.json").exitCode, 0);
-  const Result result = inDisplay(
-      "\"$DRAPE\" desk --width 640 --height 400 --exit-after 2000 --out dragged.json &\n"
-      "app=$!\n"
-      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
-      "[ -n \"$window\" ]\n"
-      "sleep 1\n"
-      "xdotool mousemove --window $window 320 200 mousedown 1\n"
-      "for x in 340 360 380 400 420 440 460; do sleep 0.2; xdotool mousemove --window $window $x 200; done\n"
-      "sleep 0.5\n"
-      "xdotool mouseup 1\n"
-      "sleep 0.5\n"
-      "xdotool key --window $window Escape\n"
-      "sleep 0.3\n"
-      "xdotool key --window $window Escape\n"
-      "wait $app");
+  const Result result = inDisplay(dragAcrossTheDesk(""));
   ASSERT_EQ(result.exitCode, 0) << result.err;
-  const auto middle = [](const json& document) {
-    double x = 0.0;
-    const json& positions = document["cloths"][0]["positions"];
-    for (const json& p : positions) x += p[0].get<double>();
-    return x / static_cast<double>(positions.size());
-  };
   // The drag went right across the picture; the camera looks at the cloth from the front right,
   // so the cloth moved along +x (and some -z).
-  EXPECT_GT(middle(state(file("dragged.json"))) - middle(state(file("still.json"))), 0.05);
+  EXPECT_GT(middleX(state(file("dragged.json"))) - middleX(state(file("still.json"))), 0.05);
 }
 
 TEST_F(App, ADragWhilePausedIsNotLostTheClothFollowsTheHandAndStopsWithIt) {
   // Paused at once (Space), then the same drag: the world steps only in frames where the finger
   // moved, so the cloth comes along, and the time stops again when the hand does.
-  const Result result = inDisplay(
-      "\"$DRAPE\" desk --width 640 --height 400 --exit-after 2000 --out dragged.json &\n"
-      "app=$!\n"
-      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
-      "[ -n \"$window\" ]\n"
-      "sleep 1\n"
-      "xdotool key --window $window space\n"
-      "sleep 0.5\n"
-      "xdotool mousemove --window $window 320 200 mousedown 1\n"
-      "for x in 340 360 380 400 420 440 460; do sleep 0.2; xdotool mousemove --window $window $x 200; done\n"
-      "sleep 0.5\n"
-      "xdotool mouseup 1\n"
-      "sleep 1\n"
-      "xdotool key --window $window Escape\n"
-      "sleep 0.3\n"
-      "xdotool key --window $window Escape\n"
-      "wait $app");
+  const Result result = inDisplay(dragAcrossTheDesk("xdotool key --window $window space\nsleep 0.5\n"));
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const json dragged = state(file("dragged.json"));
-  double x = 0.0;
-  for (const json& p : dragged["cloths"][0]["positions"]) x += p[0].get<double>();
-  x /= static_cast<double>(dragged["cloths"][0]["positions"].size());
-  EXPECT_GT(x, 0.05);  // it lay centred on x = 0
+  EXPECT_GT(middleX(dragged), 0.05);  // it lay centred on x = 0
   // A step a moved frame, and a second and a half of waiting paused: well under the 4 s it ran.
   EXPECT_LT(dragged["time"].get<double>(), 2.0);
   EXPECT_GT(dragged["time"].get<double>(), 0.0);
