@@ -152,6 +152,7 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
                            {"searches", contact.searches},
                            {"tested", contact.tested},
                            {"triangleTests", contact.triangleTests},
+                           {"cellsWalked", contact.cellsWalked},
                            {"zoned", contact.zoned},
                            {"fallbacks", contact.fallbacks}}},
                          {"energy",

@@ -155,9 +155,11 @@ glm::vec3 above(const Vec3& x) {
 }
 
 template <class Entry>
-bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, const GridBuild& build, Real inverse,
-              std::uint64_t budget) {
+bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, glm::i64vec3& lowest,
+              glm::i64vec3& highest, const GridBuild& build, Real inverse, std::uint64_t budget) {
   std::uint64_t total = 0;
+  lowest = glm::i64vec3(std::numeric_limits<std::int64_t>::max());
+  highest = glm::i64vec3(std::numeric_limits<std::int64_t>::min());
   // Cells from the boxes as the entries keep them (single precision, rounded outwards): a pair's
   // overlap then lies in cells both cover (query below).
   const auto cellsOf = [&](std::size_t i) {
@@ -169,6 +171,8 @@ bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, co
     const auto [lo, hi] = cellsOf(i);
     total += cellsIn(lo, hi);
     if (total > budget) return false;
+    lowest = glm::min(lowest, lo);
+    highest = glm::max(highest, hi);
   }
   const std::size_t table = std::bit_ceil(static_cast<std::size_t>(2 * total + 1));
   const std::size_t mask = table - 1;
@@ -210,6 +214,7 @@ std::size_t SelfContact::bytes() const {
                       b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
   for (const Grid* g : {&triangleGrid_, &edgeGrid_}) total += b(g->start) + b(g->entries);
   for (const std::vector<Pair>& found : found_) total += b(found);
+  total += b(walked_);
   return total;
 }
 
@@ -351,10 +356,10 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     boxUpper_[i] = above(upper_[i]);
   }
   const std::uint64_t budget = 16 * static_cast<std::uint64_t>(nt + ne) + 4096;
-  while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, {boxLower_.data() + n, boxUpper_.data() + n, nt},
-                   1.0 / cellSize_, budget) ||
-         !fillGrid(edgeGrid_.start, edgeGrid_.entries, {boxLower_.data() + n + nt, boxUpper_.data() + n + nt, ne},
-                   1.0 / cellSize_, budget)) {
+  while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, triangleGrid_.lowest, triangleGrid_.highest,
+                   {boxLower_.data() + n, boxUpper_.data() + n, nt}, 1.0 / cellSize_, budget) ||
+         !fillGrid(edgeGrid_.start, edgeGrid_.entries, edgeGrid_.lowest, edgeGrid_.highest,
+                   {boxLower_.data() + n + nt, boxUpper_.data() + n + nt, ne}, 1.0 / cellSize_, budget)) {
     cellSize_ *= 2.0;
   }
 
@@ -362,14 +367,20 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   found_.resize(static_cast<std::size_t>(workers.threads()));
   // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap.
   // `accept(other)`: a cheap test of the pair by its indices, after the boxes'.
-  const auto query = [&](const Grid& grid, std::size_t self, auto&& accept, auto&& emit) {
+  const auto query = [&](const Grid& grid, std::size_t self, std::int64_t& walked, auto&& accept, auto&& emit) {
     const glm::vec3 lo = boxLower_[self], hi = boxUpper_[self];
     const Real inverse = 1.0 / cellSize_;
     const glm::i64vec3 from = cellOf(Vec3(lo), inverse), to = cellOf(Vec3(hi), inverse);
+    // Only the cells that can hold entries; `needs` below still counts from the query's own first
+    // cell, so each pair is found in the same cell as when every cell was walked.
+    const glm::i64vec3 first = glm::max(from, grid.lowest), last = glm::min(to, grid.highest);
+    if (glm::all(glm::lessThanEqual(first, last))) {
+      walked += (last.x - first.x + 1) * (last.y - first.y + 1) * (last.z - first.z + 1);
+    }
     const std::size_t mask = grid.start.size() - 2;
-    for (std::int64_t z = from.z; z <= to.z; ++z) {
-      for (std::int64_t y = from.y; y <= to.y; ++y) {
-        for (std::int64_t x = from.x; x <= to.x; ++x) {
+    for (std::int64_t z = first.z; z <= last.z; ++z) {
+      for (std::int64_t y = first.y; y <= last.y; ++y) {
+        for (std::int64_t x = first.x; x <= last.x; ++x) {
           const glm::i64vec3 cell(x, y, z);
           const std::uint64_t key = packed(cell);
           const std::size_t bucket = hashOf(cell, mask);
@@ -396,14 +407,16 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   const auto list = [&](std::size_t count, const Grid& grid, std::size_t boxes, auto&& accept, auto&& corners,
                         bool edges) {
     for (std::vector<Pair>& found : found_) found.clear();
+    walked_.assign(found_.size(), 0);
     workers.run(
         count,
         [&](std::size_t begin, std::size_t end, int thread) {
           std::vector<Pair>& found = found_[static_cast<std::size_t>(thread)];
+          std::int64_t& walked = walked_[static_cast<std::size_t>(thread)];
           for (std::size_t self = begin; self < end; ++self) {
             const auto first = static_cast<std::uint32_t>(self);
             query(
-                grid, boxes + self, [&](std::uint32_t other) { return accept(first, other); },
+                grid, boxes + self, walked, [&](std::uint32_t other) { return accept(first, other); },
                 [&](std::uint32_t other) {
                   Pair pair{};
                   corners(first, other, pair.v);
@@ -416,6 +429,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
         },
         256);
     for (const std::vector<Pair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
+    for (const std::int64_t walked : walked_) stats_.cellsWalked += walked;
   };
   pairs_.clear();
   // Vertex-triangle pairs: a vertex against the triangles it is no corner of.

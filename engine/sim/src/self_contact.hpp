@@ -109,9 +109,13 @@ class SelfContact {
   struct Grid {
     std::vector<std::uint32_t> start;
     std::vector<Entry> entries;
+    // The cells its boxes cover lie within these: a query walks only the part of its own cells
+    // inside them (a particle flung 1e13 m has a box of millions of cells, almost all empty).
+    glm::i64vec3 lowest{0}, highest{-1};
   } triangleGrid_, edgeGrid_;
   Real cellSize_ = 1.0;
   std::vector<std::vector<Pair>> found_;  // per thread
+  std::vector<std::int64_t> walked_;      // per thread: grid cells its queries looked in
   std::vector<Pair> pairs_;
   std::vector<std::uint32_t> active_;  // pairs the sweeps look at
   // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is
