@@ -430,7 +430,9 @@ int runApp(const AppOptions& options) {
         if (event.type == SDL_KEYDOWN && !ImGui::GetIO().WantCaptureKeyboard) {
           const KeyAction action = keyAction(event.key.keysym.sym, (event.key.keysym.mod & KMOD_CTRL) != 0);
           if (action == KeyAction::quit) running = false;
-          if (action == KeyAction::askQuit && ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopup)) {
+          if (action == KeyAction::askQuit && event.key.repeat != 0) {
+            // Esc held down repeats: that is one press, not the second that quits.
+          } else if (action == KeyAction::askQuit && ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopup)) {
             panels.closePopups = true;  // Esc closes an open list first, and does not count towards quitting
           } else if (action == KeyAction::askQuit) {
             // Esc twice within 3 s: one stray press does not throw away drawn cloths and cuts.

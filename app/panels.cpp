@@ -370,8 +370,8 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::SameLine();
     if (ImGui::Button("step")) {
       // While running, a step pauses first: one step, then still.
-      if (session.paused) session.step();
       session.paused = true;
+      session.step();
     }
     tip("one step (pauses first while running; N or . does the same)");
     ImGui::SameLine();

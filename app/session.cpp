@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <array>
 #include <limits>
-#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -54,14 +52,14 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
   fabric_.clear();
   interaction_ = std::make_unique<interact::Interaction>(*world_);
   interaction_->settings().material = scene::drawnClothTemplate(scene_);
-  interaction_->beforeCut = [this] {
-    undo_.push_back({Undo::Kind::cut, world_->cloths()});
-    redo_.clear();
-  };
+  interaction_->beforeCut = [this] { undo_.push_back({Undo::Kind::cut, world_->cloths()}); };
   interaction_->cutNothing = [this] {
     if (!undo_.empty() && undo_.back().kind == Undo::Kind::cut) undo_.pop_back();
   };
-  interaction_->afterCut = [this](const std::vector<sim::Vec3>& cutPath) { seams_.push_back({cutPath, 0.0}); };
+  interaction_->afterCut = [this](const std::vector<sim::Vec3>& cutPath) {
+    seams_.push_back({cutPath, 0.0});
+    redo_.clear();  // a swipe that cut nothing forgets nothing
+  };
   interaction_->afterSpawn = [this] {
     undo_.push_back({Undo::Kind::spawn, {}});
     redo_.clear();
@@ -106,26 +104,38 @@ std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const st
 
 // `after` (the cloths as an undo found them, a cut or tear in them) brought to the motion since,
 // from `now` (the cloths before that cut or tear): each particle that was there before it is where
-// it is now, and each copy the cut or tear made keeps its offset from its particle (a copy has its
-// particle's rest position, bit for bit: ClothRest::duplicateRestPosition). Where the cloths do not
+// it is now, and each copy the cut or tear made keeps its offset from the particle it was split
+// from. A cut or tear keeps the triangles in their order and points some of their corners at the
+// copies (topology.cpp), so a copy's particle is the corner `now` has where `after` has the copy.
+// (A rest position does not name it: an earlier cut's copies share it.) Where the cloths do not
 // match so, `after` as it is.
 std::vector<sim::Cloth> withMotionAfter(std::vector<sim::Cloth> after, const std::vector<sim::Cloth>& now) {
   if (after.size() != now.size()) return after;
   for (std::size_t c = 0; c < after.size(); ++c) {
-    if (after[c].state.position.size() < now[c].state.position.size()) return after;
+    if (after[c].state.position.size() < now[c].state.position.size() ||
+        after[c].rest.triangles.size() != now[c].rest.triangles.size()) {
+      return after;
+    }
   }
   for (std::size_t c = 0; c < after.size(); ++c) {
     sim::ParticleState& s = after[c].state;
     const sim::ParticleState& current = now[c].state;
-    const std::vector<glm::vec3>& rest = after[c].rest.restOffsets;
     const std::size_t n = current.position.size();
-    std::map<std::array<float, 3>, std::size_t> particleAt;
-    for (std::size_t i = 0; i < n; ++i) particleAt.emplace(std::array<float, 3>{rest[i].x, rest[i].y, rest[i].z}, i);
+    std::vector<std::size_t> splitFrom(s.position.size(), n);  // n: not found
+    const std::vector<glm::uvec3>& cornersAfter = after[c].rest.triangles;
+    const std::vector<glm::uvec3>& cornersNow = now[c].rest.triangles;
+    for (std::size_t t = 0; t < cornersAfter.size(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const std::size_t copy = cornersAfter[t][k], particle = cornersNow[t][k];
+        if (copy >= n && particle < n && after[c].rest.restOffsets[copy] == after[c].rest.restOffsets[particle]) {
+          splitFrom[copy] = particle;
+        }
+      }
+    }
     const std::vector<sim::Vec3> position = s.position, previous = s.previousPosition;
     for (std::size_t j = n; j < s.position.size(); ++j) {
-      const auto found = particleAt.find({rest[j].x, rest[j].y, rest[j].z});
-      if (found == particleAt.end()) continue;
-      const std::size_t i = found->second;
+      const std::size_t i = splitFrom[j];
+      if (i >= n) continue;
       s.position[j] = current.position[i] + (position[j] - position[i]);
       s.previousPosition[j] = current.previousPosition[i] + (previous[j] - previous[i]);
       if (j < s.velocity.size() && i < current.velocity.size()) s.velocity[j] = current.velocity[i];
@@ -245,7 +255,8 @@ std::optional<std::string> Session::save(const std::filesystem::path& file) cons
 void Session::reset() {
   const sim::WorldSettings tuned = world_->settings();
   if (isSnapshot(path_)) {
-    load(path_);
+    const render::Camera keep = camera_;
+    if (!load(path_)) camera_ = keep;
   } else {
     auto world = std::make_unique<sim::World>(scene_.world);
     const render::Camera keep = camera_;

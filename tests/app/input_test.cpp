@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "drape/sim/metrics.hpp"
 #include "input.hpp"
 #include "session.hpp"
 
@@ -380,6 +381,44 @@ TEST(Session, RedoPutsBackACutWithTheMotionSinceAndADrawnClothAsItWas) {
   ASSERT_TRUE(hand.move(3, interact::Pointer::at({0.5, 0.0, 0.1})));
   ASSERT_TRUE(hand.up(3));
   EXPECT_FALSE(session.redo());
+}
+
+TEST(Session, RedoOfACutAcrossAnEarlierCutPutsEachCopyBesideItsOwnParticle) {
+  // A first cut along z = 0 and its far half (the piece of particle 0) carried 15 cm along x; a
+  // second cut along x = 0 across the first, undone; the far half carried 10 cm more; the second
+  // cut redone. Particles on the first seam have two copies at one rest position, one on each
+  // half: each copy of the second cut must come back beside its own, which moved 10 cm since the
+  // undo, or a link spans those 10 cm and the strain shows it.
+  Session session("desk");
+  interact::Interaction& hand = session.interaction();
+  hand.setMode(interact::Mode::cut);
+  ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.5, 0.0, 0.0})));
+  ASSERT_TRUE(hand.move(1, interact::Pointer::at({0.5, 0.0, 0.001})));
+  ASSERT_TRUE(hand.up(1));
+  ASSERT_EQ(session.world().cloths()[0].pieceCount, 2u);
+  const auto carryFarHalf = [&](double dx) {
+    std::vector<sim::Cloth> cloths = session.world().cloths();
+    sim::Cloth& cloth = cloths[0];
+    const std::vector<std::uint32_t> piece = cloth.piece;
+    for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+      if (piece.empty() || piece[i] != piece[0]) continue;
+      cloth.state.position[i].x += dx;
+      cloth.state.previousPosition[i].x += dx;
+    }
+    session.world().restoreCloths(std::move(cloths));
+  };
+  carryFarHalf(0.15);
+  const double strainBefore = sim::structuralStrain(session.world()).max;
+  ASSERT_TRUE(hand.down(2, interact::Pointer::at({0.001, 0.0, -0.5})));
+  ASSERT_TRUE(hand.move(2, interact::Pointer::at({0.0, 0.0, 0.5})));
+  ASSERT_TRUE(hand.up(2));
+  const std::size_t cutParticles = session.world().cloths()[0].state.position.size();
+  const double strainCut = sim::structuralStrain(session.world()).max;
+  ASSERT_TRUE(session.undo());
+  carryFarHalf(0.10);
+  ASSERT_TRUE(session.redo());
+  ASSERT_EQ(session.world().cloths()[0].state.position.size(), cutParticles);
+  EXPECT_LE(sim::structuralStrain(session.world()).max, std::max(strainCut, strainBefore) + 1e-9);
 }
 
 TEST(Session, SaveAndLoadBringBackATornClothExactly) {

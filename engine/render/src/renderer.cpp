@@ -145,8 +145,9 @@ std::vector<std::uint32_t> triangleEdges(const std::vector<glm::uvec3>& triangle
 }
 
 // The pixels (x, y, width, height from the bottom left) that the box around the cloths and the
-// finite colliders covers in the picture, a pixel wider each way: FXAA looks for edges there only.
-// The whole picture where a corner is behind the eye.
+// finite colliders covers in the picture, two pixels wider each way: FXAA looks for edges there
+// only (overlay lines outside it, a seam or a ring, are not smoothed). The whole picture where a
+// corner is behind the eye.
 std::array<int, 4> coveredPixels(const sim::World& world, const Camera& camera, int width, int height) {
   glm::dvec3 lower{std::numeric_limits<double>::max()}, upper{std::numeric_limits<double>::lowest()};
   for (const sim::Cloth& cloth : world.cloths()) {
@@ -174,10 +175,14 @@ std::array<int, 4> coveredPixels(const sim::World& world, const Camera& camera, 
     top = std::min(top, at->y);
     bottom = std::max(bottom, at->y);
   }
-  const int x0 = std::clamp(static_cast<int>(std::floor(left * width)) - 2, 0, width);
-  const int x1 = std::clamp(static_cast<int>(std::ceil(right * width)) + 2, 0, width);
-  const int y0 = std::clamp(static_cast<int>(std::floor((1.0 - bottom) * height)) - 2, 0, height);
-  const int y1 = std::clamp(static_cast<int>(std::ceil((1.0 - top) * height)) + 2, 0, height);
+  // Clamped as doubles before they become ints: a corner just in front of the eye projects
+  // beyond any int (a NaN, from a corner on the eye, goes to the whole picture's edge).
+  const auto pixel = [](double at, int size, double pad) {
+    const double p = at * size + pad;
+    return p >= 0.0 ? static_cast<int>(std::min(p, static_cast<double>(size))) : 0;
+  };
+  const int x0 = pixel(left, width, -2.0), x1 = std::max(pixel(right, width, 3.0), x0);
+  const int y0 = pixel(1.0 - bottom, height, -2.0), y1 = std::max(pixel(1.0 - top, height, 3.0), y0);
   return {x0, y0, x1 - x0, y1 - y0};
 }
 
@@ -413,9 +418,11 @@ struct Renderer::Impl {
     const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     pictureWidth = width;
     pictureHeight = height;
-    if (!complete) {
+    if (!complete) {  // drawn without FXAA; tried again (with new names) at the next size
       glDeleteFramebuffers(1, &pictureFramebuffer);
-      pictureFramebuffer = 0;
+      glDeleteTextures(1, &pictureColour);
+      glDeleteRenderbuffers(1, &pictureDepth);
+      pictureFramebuffer = pictureColour = pictureDepth = 0;
     }
     return complete;
   }
