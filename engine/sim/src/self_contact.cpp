@@ -32,8 +32,11 @@ constexpr Real kTorn = 10.0;
 
 // `inverse`: 1 / the cell's size.
 glm::i64vec3 cellOf(Vec3 x, Real inverse) {
-  // Positions are finite and within 1e6 m (the guard): the cell always fits.
-  const Vec3 c = glm::clamp(x, Vec3(-2.0e6), Vec3(2.0e6)) * inverse;
+  // The guard keeps positions finite and within 1e6 m between steps, but within a step a box may
+  // be beyond that, or NaN (a fuzzed snapshot's overflow): clamped first, a NaN to the lowest
+  // corner (its box overlaps nothing), the cell always fits.
+  const auto bounded = [](Real v) { return v >= -2.0e6 ? (v <= 2.0e6 ? v : 2.0e6) : -2.0e6; };
+  const Vec3 c = Vec3(bounded(x.x), bounded(x.y), bounded(x.z)) * inverse;
   return {static_cast<std::int64_t>(std::floor(c.x)), static_cast<std::int64_t>(std::floor(c.y)),
           static_cast<std::int64_t>(std::floor(c.z))};
 }
@@ -348,6 +351,9 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   // Cells about a triangle's box wide; wider while a few huge boxes (a particle flung far) would
   // fill the grid.
   cellSize_ = kept > 0 ? std::max(1.5 * extent / static_cast<Real>(kept), 1e-6) : 1.0;
+  // A NaN corner (the guard reports it after the step) makes the extent NaN: any size serves then,
+  // and a NaN one would never fit the grid's budget however often it doubled.
+  if (!std::isfinite(cellSize_)) cellSize_ = 1.0;
   // The boxes as the grid keeps them: single precision, rounded outwards.
   boxLower_.resize(n + nt + ne);
   boxUpper_.resize(n + nt + ne);
