@@ -129,7 +129,8 @@ class TouchReplay {
         case T::down:
         case T::move:
           if (at || world) {
-            pushTouch(window, type == T::down ? SDL_FINGERDOWN : SDL_FINGERMOTION, e.finger, at.value_or(glm::dvec2{0.5}));
+            pushTouch(window, type == T::down ? SDL_FINGERDOWN : SDL_FINGERMOTION, e.finger,
+                      at.value_or(glm::dvec2{0.5}));
             beside_[e.finger].push_back(beside);
           }
           break;
@@ -246,7 +247,8 @@ KeyAction keyAction(SDL_Keycode key, bool ctrl) {
     case SDLK_PERIOD: return KeyAction::step;
     case SDLK_r: return KeyAction::reset;
     case SDLK_u: return KeyAction::undo;
-    case SDLK_z: return ctrl ? ((SDL_GetModState() & KMOD_SHIFT) != 0 ? KeyAction::redo : KeyAction::undo) : KeyAction::none;
+    case SDLK_z:
+      return ctrl ? ((SDL_GetModState() & KMOD_SHIFT) != 0 ? KeyAction::redo : KeyAction::undo) : KeyAction::none;
     case SDLK_y: return ctrl ? KeyAction::redo : KeyAction::none;
     case SDLK_p:
     case SDLK_F12: return KeyAction::screenshot;
@@ -411,9 +413,8 @@ int runApp(const AppOptions& options) {
       last = now;
       WindowSize size = sizeOf(window);
       // Screen points of a script with a camera are points of its picture, at its aspect.
-      session->interaction().setCamera(session->camera(), replay && replay->script().camera
-                                                              ? replay->script().aspect
-                                                              : size.aspect());
+      session->interaction().setCamera(session->camera(),
+                                       replay && replay->script().camera ? replay->script().aspect : size.aspect());
       if (replay) replay->beforeStep(window, *session, size.aspect());
 
       bool stepOnce = false;

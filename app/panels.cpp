@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <optional>
 #include <string>
-#include <fstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -81,8 +81,8 @@ void noteWindow(PanelState& panels) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   if (display.x <= 0.0f || display.y <= 0.0f) return;
   const ImVec2 at = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
-  panels.windows.push_back({at.x / display.x, at.y / display.y, (at.x + size.x) / display.x,
-                            (at.y + size.y) / display.y});
+  panels.windows.push_back(
+      {at.x / display.x, at.y / display.y, (at.x + size.x) / display.x, (at.y + size.y) / display.y});
 }
 
 const char* modeHint(interact::Mode mode, bool small) {
@@ -137,7 +137,8 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
   // shorter, the status, and what is being drawn), then the detail.
   const bool small = display.x < 640.0f || display.y < 420.0f;
   ImGui::TextColored(ImVec4(0.7f, 0.9f, 1.0f, 1.0f), "%s", modeHint(interaction.mode(), small));
-  ImGui::TextColored(ImVec4(0.85f, 0.85f, 0.85f, 1.0f), "1 sticky  2 cut  3 create   F frame   Home view   F1 all keys");
+  ImGui::TextColored(ImVec4(0.85f, 0.85f, 0.85f, 1.0f),
+                     "1 sticky  2 cut  3 create   F frame   Home view   F1 all keys");
   for (const interact::TouchView& touch : interaction.touches()) {
     if (touch.mode != interact::Mode::create) continue;
     const OutlineSize size = outlineSize(touch.stroke, interaction.settings().spacing);
@@ -191,7 +192,8 @@ void strainLegend(PanelState& panels) {
       const glm::vec3 c = render::strainColour(scale * static_cast<float>(k) / kSteps, scale);
       return ImGui::GetColorU32(ImVec4(c.r, c.g, c.b, 1.0f));
     };
-    const float x0 = at.x + width * static_cast<float>(i) / kSteps, x1 = at.x + width * static_cast<float>(i + 1) / kSteps;
+    const float x0 = at.x + width * static_cast<float>(i) / kSteps,
+                x1 = at.x + width * static_cast<float>(i + 1) / kSteps;
     draw->AddRectFilledMultiColor(ImVec2(x0, at.y), ImVec2(x1, at.y + height), colour(i), colour(i + 1), colour(i + 1),
                                   colour(i));
   }
@@ -213,7 +215,8 @@ void help(PanelState& panels) {
   // On a small window it keeps inside it: the descriptions wrap, and it scrolls.
   const float width = std::min(display.x - 20.0f, ImGui::GetFontSize() * 52.0f);
   ImGui::SetNextWindowSize(ImVec2(std::max(width, 100.0f), 0.0f), ImGuiCond_Always);
-  ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f), ImVec2(display.x - 20.0f, std::max(display.y - 20.0f, 60.0f)));
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f),
+                                      ImVec2(display.x - 20.0f, std::max(display.y - 20.0f, 60.0f)));
   ImGui::Begin("Help", nullptr, ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoResize);
   noteWindow(panels);
   if (ImGui::BeginTable("bindings", 2, ImGuiTableFlags_SizingStretchProp)) {
@@ -387,7 +390,8 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     if (ImGui::Button("redo")) session.redo();
     // Only beside the rest where the panel is wide enough.
     const ImGuiStyle& style = ImGui::GetStyle();
-    if (ImGui::GetItemRectMax().x + style.ItemSpacing.x + ImGui::CalcTextSize("screenshot").x + 2.0f * style.FramePadding.x <
+    if (ImGui::GetItemRectMax().x + style.ItemSpacing.x + ImGui::CalcTextSize("screenshot").x +
+            2.0f * style.FramePadding.x <
         ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) {
       ImGui::SameLine();
     }
@@ -521,11 +525,11 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       sim::Friction& f = tuned.colliders[i].friction;
       const sim::ColliderShape shape = tuned.colliders[i].shape;
       ImGui::Text("collider %zu: %s", i,
-                  shape == sim::ColliderShape::plane    ? "the table (a plane)"
-                  : shape == sim::ColliderShape::sphere ? "a ball"
-                  : shape == sim::ColliderShape::box    ? "a box"
+                  shape == sim::ColliderShape::plane     ? "the table (a plane)"
+                  : shape == sim::ColliderShape::sphere  ? "a ball"
+                  : shape == sim::ColliderShape::box     ? "a box"
                   : shape == sim::ColliderShape::capsule ? "a capsule"
-                                                          : "a mesh");
+                                                         : "a mesh");
       changed |= sliderReal("static friction", f.staticCoefficient, 0.0, 2.0);
       changed |= sliderReal("kinetic friction", f.kineticCoefficient, 0.0, 2.0);
       ImGui::PopID();
@@ -644,7 +648,7 @@ render::Overlay fingerOverlay(Session& session, const InputMapper& input) {
   const interact::Interaction& interaction = session.interaction();
   for (const interact::TouchView& touch : interaction.touches()) {
     if (touch.mode == interact::Mode::sticky) {
-      const glm::vec4 colour = touch.pinched          ? glm::vec4{1.0f, 0.85f, 0.2f, 1.0f}
+      const glm::vec4 colour = touch.pinched            ? glm::vec4{1.0f, 0.85f, 0.2f, 1.0f}
                                : input.parked(touch.id) ? glm::vec4{0.3f, 0.9f, 1.0f, 1.0f}
                                                         : glm::vec4{1.0f, 1.0f, 1.0f, 1.0f};
       overlay.addRing(touch.position, interaction.settings().radius, glm::dvec3{0.0, 1.0, 0.0}, colour);

@@ -69,7 +69,7 @@ struct PanelState {
   // The panels' windows as they were last drawn, in normalised window coordinates: an event over
   // one goes to the panels (overAny), decided for each event as it comes.
   std::vector<ScreenRect> windows;
-  float panelWidth = 0.0f;  // points, of the main panel as last drawn (0 when hidden)
+  float panelWidth = 0.0f;                                    // points, of the main panel as last drawn (0 when hidden)
   float lastDisplayWidth = -1.0f, lastDisplayHeight = -1.0f;  // the panel is placed again when these change
   bool collapsedBySize = false;  // the panel was collapsed because the window was too small
   bool showHelp = false;

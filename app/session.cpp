@@ -180,10 +180,10 @@ void Session::frame(glm::dvec3 lower, glm::dvec3 upper, double yaw, double pitch
 void Session::resetView() {
   glm::dvec3 lower, upper;
   render::sceneBounds(*world_, lower, upper);
-  const bool onlyTable = world_->cloths().empty() &&
-                         std::all_of(world_->colliders().begin(), world_->colliders().end(), [](const sim::Collider& c) {
-                           return c.settings().shape == sim::ColliderShape::plane;
-                         });
+  const bool onlyTable =
+      world_->cloths().empty() &&
+      std::all_of(world_->colliders().begin(), world_->colliders().end(),
+                  [](const sim::Collider& c) { return c.settings().shape == sim::ColliderShape::plane; });
   if (onlyTable) {
     // Nothing on the table: 80 cm of it, so that an outline a quarter of the window wide makes a
     // cloth about half a metre across, as the desk's (sceneBounds would frame two metres and more).

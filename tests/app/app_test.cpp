@@ -293,7 +293,8 @@ double largestDifference(const json& a, const json& b) {
     const json& q = b["cloths"][c]["positions"];
     if (p.size() != q.size()) return INFINITY;
     for (std::size_t i = 0; i < p.size(); ++i) {
-      const double dx = p[i][0].get<double>() - q[i][0].get<double>(), dy = p[i][1].get<double>() - q[i][1].get<double>(),
+      const double dx = p[i][0].get<double>() - q[i][0].get<double>(),
+                   dy = p[i][1].get<double>() - q[i][1].get<double>(),
                    dz = p[i][2].get<double>() - q[i][2].get<double>();
       largest = std::max(largest, std::sqrt(dx * dx + dy * dy + dz * dz));
     }
@@ -306,8 +307,8 @@ double largestDifference(const json& a, const json& b) {
 // to be projected onto the screen and back onto the table, so the fold gesture ended 0.57 m off),
 // and a down's own radius with it (the tear ended with 737 particles, not 733). Screen points go
 // through SDL's single-precision touch coordinates, so the tolerance is 1e-6 m (the world-point
-// gestures were seen to end bit for bit the same; docs/app.md). The gestures that cover every path an event takes (world and
-// screen points, a down's radius, pin, lift and unpin, pinch-lift, cut, draw, tearing): the
+// gestures were seen to end bit for bit the same; docs/app.md). The gestures that cover every path an event takes
+// (world and screen points, a down's radius, pin, lift and unpin, pinch-lift, cut, draw, tearing): the
 // self-contact-heavy rest (crumple, drape, rotate, spread, translate) take the app 7 to 20 s each
 // and the same paths; docs/app.md says how they were checked. Under the sanitizers, four of them.
 TEST_F(App, ReplayingAShippedGestureEndsWhereDrapeCliReplayEnds) {
@@ -326,7 +327,7 @@ TEST_F(App, ReplayingAShippedGestureEndsWhereDrapeCliReplayEnds) {
   for (const std::string& gesture : gestures) {
     const std::string path = "\"$DRAPE_ASSETS/gestures/" + gesture + ".json\"";
     // drape-cli says how many steps the script takes; the app takes one a frame (on one thread, as
-  // drape-cli: the result is the same on any number, and llvmpipe draws on the other core).
+    // drape-cli: the result is the same on any number, and llvmpipe draws on the other core).
     script += "steps=$('" + std::string(DRAPE_CLI) + "' replay " + sceneOf(gesture) + " " + path + " --out cli-" +
               gesture + ".json | sed -n 's/.*: \\([0-9]*\\) steps.*/\\1/p')\n";
     script += "\"$DRAPE\" " + sceneOf(gesture) + " --replay " + path + " --exit-after \"$steps\" --out app-" + gesture +

@@ -603,8 +603,8 @@ TEST(Session, FramingLeavesThePanelsPartOfTheWindowAndFFramesTheClothWhereverItI
   session.resetView();
   clothOnScreen(left, right);
   EXPECT_GT(left, 0.0);
-  EXPECT_LT(right, 0.7);                             // clear of the panel
-  EXPECT_NEAR((left + right) / 2.0, 0.35, 0.05);     // in the middle of what is left
+  EXPECT_LT(right, 0.7);                          // clear of the panel
+  EXPECT_NEAR((left + right) / 2.0, 0.35, 0.05);  // in the middle of what is left
   // Carry the cloth off to one side and look elsewhere: F brings it back into view.
   std::vector<sim::Cloth> moved = session.world().cloths();
   for (sim::Vec3& x : moved[0].state.position) x += sim::Vec3{3.0, 0.0, -2.0};

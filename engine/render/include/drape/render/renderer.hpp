@@ -53,9 +53,9 @@ struct FrameOptions {
   bool strainMap = false;     // colour by stretch instead of the front/back colours
   float strainScale = 0.10f;  // strain shown fully red
   bool showPins = true;
-  bool woven = true;        // a gingham check and a weave printed on the cloth (not with strainMap)
-  bool wireframe = false;   // the triangles' edges over the surface
-  bool particles = false;   // every particle as a dot
+  bool woven = true;         // a gingham check and a weave printed on the cloth (not with strainMap)
+  bool wireframe = false;    // the triangles' edges over the surface
+  bool particles = false;    // every particle as a dot
   bool multisample = true;   // 4x MSAA when the context has it
   bool fxaa = true;          // without MSAA: FXAA, one cheap filter pass over the picture
   int shadowSoftness = 3;    // 0..3: shadow filter taps (2s+1)^2 on the table; a software renderer pays for each
