@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -195,13 +194,8 @@ void Session::resetView() {
 }
 
 void Session::frameCloths() {
-  glm::dvec3 lower{std::numeric_limits<double>::max()}, upper{std::numeric_limits<double>::lowest()};
-  for (const sim::Cloth& cloth : world_->cloths()) {
-    for (const sim::Vec3& x : cloth.state.position) {
-      lower = glm::min(lower, x);
-      upper = glm::max(upper, x);
-    }
-  }
+  glm::dvec3 lower, upper;
+  render::clothBounds(*world_, lower, upper);
   if (lower.x > upper.x) {
     status = "no cloth to frame";
     return;

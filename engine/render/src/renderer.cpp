@@ -144,24 +144,11 @@ std::vector<std::uint32_t> triangleEdges(const std::vector<glm::uvec3>& triangle
   return pairs;
 }
 
-// The pixels (x, y, width, height from the bottom left) that the box around the cloths and the
-// finite colliders covers in the picture, two pixels wider each way: FXAA looks for edges there
-// only (overlay lines outside it, a seam or a ring, are not smoothed). The whole picture where a
-// corner is behind the eye.
-std::array<int, 4> coveredPixels(const sim::World& world, const Camera& camera, int width, int height) {
-  glm::dvec3 lower{std::numeric_limits<double>::max()}, upper{std::numeric_limits<double>::lowest()};
-  for (const sim::Cloth& cloth : world.cloths()) {
-    for (const sim::Vec3& x : cloth.state.position) {
-      lower = glm::min(lower, x);
-      upper = glm::max(upper, x);
-    }
-  }
-  glm::dvec3 collidersLower, collidersUpper;
-  sceneBounds(world, collidersLower, collidersUpper);  // cloths, finite colliders and the table's height
-  if (world.colliders().size() > 0) {
-    lower = glm::min(lower, collidersLower);
-    upper = glm::max(upper, collidersUpper);
-  }
+// The pixels (x, y, width, height from the bottom left) that the box [lower, upper] (the cloths
+// and the finite colliders) covers in the picture, two pixels wider each way: FXAA looks for edges
+// there only (overlay lines outside it, a seam or a ring, are not smoothed). The whole picture
+// where the box is empty or a corner is behind the eye.
+std::array<int, 4> coveredPixels(const Camera& camera, int width, int height, glm::dvec3 lower, glm::dvec3 upper) {
   const std::array<int, 4> whole{0, 0, width, height};
   if (!(lower.x <= upper.x)) return whole;
   const double aspect = static_cast<double>(width) / height;
@@ -222,7 +209,7 @@ glm::vec3 strainColour(float strain, float scale) {
   return glm::mix(warm, hot, (t - 0.66f) / 0.34f);
 }
 
-void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
+void clothBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
   lower = glm::dvec3{std::numeric_limits<double>::max()};
   upper = glm::dvec3{std::numeric_limits<double>::lowest()};
   for (const sim::Cloth& cloth : world.cloths()) {
@@ -231,6 +218,12 @@ void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) 
       upper = glm::max(upper, x);
     }
   }
+}
+
+namespace {
+
+// The cloths' box [lower, upper] grown to sceneBounds: the finite colliders, the table under it.
+void growToScene(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
   for (const sim::Collider& collider : world.colliders()) {
     const sim::ColliderSettings& s = collider.settings();
     // A bounding sphere of each finite shape (planes are endless; meshes use their vertices).
@@ -250,6 +243,13 @@ void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) 
     upper = glm::dvec3{1.0, 1.0, 1.0};
   }
   lower.y = std::min(lower.y, 0.0);
+}
+
+}  // namespace
+
+void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
+  clothBounds(world, lower, upper);
+  growToScene(world, lower, upper);
 }
 
 struct Renderer::Impl {
@@ -576,9 +576,12 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
                  g.indices.data(), GL_STREAM_DRAW);
   }
 
-  // The light looks at the scene from kTowardsLight with an orthographic box around it.
-  glm::dvec3 lower, upper;
-  sceneBounds(world, lower, upper);
+  // The light looks at the scene from kTowardsLight with an orthographic box around it. One pass
+  // over the particles serves it and FXAA's rectangle (the cloths alone where nothing else stands).
+  glm::dvec3 clothLower, clothUpper;
+  clothBounds(world, clothLower, clothUpper);
+  glm::dvec3 lower = clothLower, upper = clothUpper;
+  growToScene(world, lower, upper);
   const glm::dvec3 centre = (lower + upper) * 0.5;
   const double radius = std::max(0.5, glm::length(upper - lower) * 0.5) * 1.1;
   const glm::mat4 lightView =
@@ -772,7 +775,9 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target));
     glViewport(0, 0, width, height);
-    const std::array<int, 4> covered = coveredPixels(world, camera, width, height);
+    const std::array<int, 4> covered = world.colliders().empty()
+                                           ? coveredPixels(camera, width, height, clothLower, clothUpper)
+                                           : coveredPixels(camera, width, height, lower, upper);
     glEnable(GL_SCISSOR_TEST);
     glScissor(covered[0], covered[1], covered[2], covered[3]);
     glDisable(GL_DEPTH_TEST);

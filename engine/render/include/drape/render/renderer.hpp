@@ -99,5 +99,7 @@ class Renderer {
 
 // The box around every particle and finite collider of the world (and the table at y = 0 under it).
 void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper);
+// The box around every particle of the world; lower > upper where there is none.
+void clothBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper);
 
 }  // namespace drape::render
