@@ -29,10 +29,7 @@ void main() {
     if (dot(d, d) > dot(axis, axis)) axis = d;
   }
   // Too little difference to be an edge (about 20 of 255 in one channel): left alone.
-  if (dot(axis, axis) < 0.0064) {
-    fragmentColour = vec4(centre, 1.0);
-    return;
-  }
+  if (dot(axis, axis) < 0.0064) discard;
   axis = normalize(axis);
   float dl = dot(downLeft - centre, axis), dr = dot(downRight - centre, axis);
   float ul = dot(upLeft - centre, axis), ur = dot(upRight - centre, axis);

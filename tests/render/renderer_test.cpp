@@ -222,5 +222,33 @@ TEST_F(RendererTest, FxaaBlendsTheClothsEdgesAsMultisamplingDoes) {
   std::printf("blended pixels: none %d, FXAA %d, MSAA %d\n", aliased, filtered, multisampled);
 }
 
+TEST_F(RendererTest, FxaaFiltersEachFrameFromThatFramesPicture) {
+  // FXAA copies the part of the picture it filters into a texture of its own; drawn after another
+  // frame (the table's shadow map bound in between), the picture is the one a renderer that drew
+  // nothing before makes: the copy lands in FXAA's texture, not in the shadow map.
+  sim::WorldSettings settings = sheet(0.3);
+  settings.colliders.push_back(sim::ColliderSettings{});  // the table, with the sheet's shadow on it
+  const sim::World world(settings);
+  Camera before = fromAbove(1.0);
+  before.yaw = 0.52;
+  Camera camera = before;
+  camera.pitch = 0.6;
+  camera.pan(0.12, -0.12);
+  FrameOptions options;
+  options.multisample = false;
+  options.fxaa = true;
+  renderer_->render(world, before, kWidth, kHeight, options);
+  renderer_->render(world, camera, kWidth, kHeight, options);
+  const std::vector<std::uint8_t> second = renderer_->readPixels(kWidth, kHeight);
+  Renderer fresh(context_->procAddress());
+  fresh.render(world, camera, kWidth, kHeight, options);
+  const std::vector<std::uint8_t> first = fresh.readPixels(kWidth, kHeight);
+  ASSERT_EQ(second.size(), first.size());
+  int differing = 0;
+  for (std::size_t i = 0; i < first.size(); ++i) differing += first[i] != second[i];
+  EXPECT_EQ(differing, 0);
+  EXPECT_GT(blended(second, options), 40);  // and it was filtered
+}
+
 }  // namespace
 }  // namespace drape::render
