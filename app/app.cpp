@@ -35,6 +35,40 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// What each frame cost, part by part, for --timings: medians, so a hiccup (a page fault, the X
+// server) does not move them; the first frames (shaders compiled, the panel laid out) are left out.
+struct TimingLog {
+  static constexpr std::size_t kWarmUp = 30;
+  std::vector<double> frame, simulation, steps, scene, panels, swap;
+
+  void add(double frameSeconds, const FrameStats& stats) {
+    frame.push_back(frameSeconds * 1e3);
+    simulation.push_back(stats.simulationSeconds * 1e3);
+    steps.push_back(stats.steps);
+    scene.push_back(stats.sceneSeconds * 1e3);
+    panels.push_back(stats.panelSeconds * 1e3);
+    swap.push_back(stats.swapSeconds * 1e3);
+  }
+  static double median(std::vector<double> values) {
+    values.erase(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(std::min(kWarmUp, values.size())));
+    if (values.empty()) return 0.0;
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  }
+  std::string summary(int width, int height) const {
+    const double frameMs = median(frame);
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "timings: %zu frames at %d x %d pixels, median ms: frame %.1f (%.0f fps), simulation %.1f (%.0f "
+                  "steps), scene %.1f, panels %.1f, swap %.1f",
+                  frame.size() > kWarmUp ? frame.size() - kWarmUp : 0, width, height, frameMs,
+                  frameMs > 0.0 ? 1e3 / frameMs : 0.0, median(simulation), median(steps), median(scene), median(panels),
+                  median(swap));
+    return line;
+  }
+};
+
 // The touch device replayed scripts speak through.
 constexpr SDL_TouchID kReplayTouch = 4242;
 
@@ -402,6 +436,8 @@ int runApp(const AppOptions& options) {
     remap();
 
     std::int64_t frame = 0;
+    TimingLog timings;
+    WindowSize timedSize = sizeOf(window);
     bool running = true;
     std::optional<Clock::time_point> quitAsked;
     // The first view is framed once the panel's width is known, unless a script brought its camera.
@@ -533,6 +569,10 @@ int runApp(const AppOptions& options) {
         SDL_Delay(16);  // nothing to draw: do not spin
       }
       stats.drawing(std::chrono::duration<double>(Clock::now() - drawStart).count(), elapsed);
+      if (options.timings && size.drawable()) {
+        timings.add(elapsed, stats);
+        timedSize = size;
+      }
 
       ++frame;
       if (options.exitAfter && frame >= *options.exitAfter) running = false;
@@ -558,6 +598,7 @@ int runApp(const AppOptions& options) {
         exitCode = 2;
       }
     }
+    if (options.timings) std::cout << timings.summary(timedSize.pixelsWide, timedSize.pixelsHigh) << std::endl;
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplSDL2_Shutdown();
     ImGui::DestroyContext();

@@ -23,6 +23,7 @@ struct AppOptions {
   int width = 1280;
   int height = 800;
   std::optional<int> threads;  // simulation threads; by default every core (at most 8)
+  bool timings = false;        // at exit, print the median cost of a frame's parts to stdout
 };
 
 int runApp(const AppOptions& options);

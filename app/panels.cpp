@@ -454,7 +454,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
 
   sim::WorldSettings tuned = world.settings();
   bool changed = false;
-  if (ImGui::CollapsingHeader("Solver", ImGuiTreeNodeFlags_DefaultOpen)) {
+  if (ImGui::CollapsingHeader("Solver")) {
     // Model and integrator restart the scene (materials mean different things in the two models).
     int model = tuned.solver.model == sim::Model::position ? 0 : 1;
     const char* models[] = {"position", "force (springs)"};
@@ -571,7 +571,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::SliderInt("shadow map", &panels.frameOptions.shadowMapSize, 256, 4096);
   }
 
-  if (ImGui::CollapsingHeader("Plots", ImGuiTreeNodeFlags_DefaultOpen)) {
+  if (ImGui::CollapsingHeader("Plots")) {
     std::size_t particles = 0, constraints = 0, torn = 0, pieces = 0;
     for (const sim::Cloth& cloth : world.cloths()) {
       particles += cloth.state.position.size();
