@@ -39,10 +39,11 @@ using Clock = std::chrono::steady_clock;
 // server) does not move them; the first frames (shaders compiled, the panel laid out) are left out.
 struct TimingLog {
   static constexpr std::size_t kWarmUp = 30;
-  std::vector<double> frame, simulation, steps, scene, panels, swap;
+  std::vector<double> frame, simulation, steps, scene, scale, panels, swap;
 
-  void add(double frameSeconds, const FrameStats& stats) {
+  void add(double frameSeconds, const FrameStats& stats, double renderScale) {
     frame.push_back(frameSeconds * 1e3);
+    scale.push_back(renderScale * 100.0);
     simulation.push_back(stats.simulationSeconds * 1e3);
     steps.push_back(stats.steps);
     scene.push_back(stats.sceneSeconds * 1e3);
@@ -61,10 +62,10 @@ struct TimingLog {
     char line[320];
     std::snprintf(line, sizeof line,
                   "timings: %zu frames at %d x %d pixels, median ms: frame %.1f (%.0f fps), simulation %.1f (%.0f "
-                  "steps), scene %.1f, panels %.1f, swap %.1f",
+                  "steps), scene %.1f (at %.0f %% of the window), panels %.1f, swap %.1f",
                   frame.size() > kWarmUp ? frame.size() - kWarmUp : 0, width, height, frameMs,
-                  frameMs > 0.0 ? 1e3 / frameMs : 0.0, median(simulation), median(steps), median(scene), median(panels),
-                  median(swap));
+                  frameMs > 0.0 ? 1e3 / frameMs : 0.0, median(simulation), median(steps), median(scene), median(scale),
+                  median(panels), median(swap));
     return line;
   }
 };
@@ -405,6 +406,10 @@ int runApp(const AppOptions& options) {
 
     ImGuiMouse imguiMouse;
     PanelState panels;
+    if (options.renderScale) {
+      panels.renderScale.setAutomatic(false);
+      panels.renderScale.set(*options.renderScale);
+    }
     FrameStats stats;
     FixedStepper stepper;
     interact::GestureScript recording;
@@ -527,8 +532,15 @@ int runApp(const AppOptions& options) {
 
       // Draw: the scene, then the panels over it. A minimised or zero-size window draws nothing.
       const Clock::time_point drawStart = Clock::now();
+      double frameScale = 1.0;  // the render scale this frame was drawn at
       if (size.drawable()) {
         render::FrameOptions frameOptions = panels.frameOptions;
+        frameOptions.renderScale = static_cast<float>(panels.renderScale.scale());
+        frameScale = panels.renderScale.scale();
+        frameOptions.hiddenRight = size.width > 0
+                                       ? static_cast<int>(panels.hiddenRight * static_cast<float>(size.pixelsWide) /
+                                                          static_cast<float>(size.width))
+                                       : 0;
         renderer->render(session->world(), session->camera(), size.pixelsWide, size.pixelsHigh, frameOptions,
                          fingerOverlay(*session, *input));
         renderer->finish();
@@ -569,8 +581,11 @@ int runApp(const AppOptions& options) {
         SDL_Delay(16);  // nothing to draw: do not spin
       }
       stats.drawing(std::chrono::duration<double>(Clock::now() - drawStart).count(), elapsed);
+      if (size.drawable()) {
+        panels.renderScale.frame(stats.simulationSeconds + stats.sceneSeconds + stats.panelSeconds, stats.sceneSeconds);
+      }
       if (options.timings && size.drawable()) {
-        timings.add(elapsed, stats);
+        timings.add(elapsed, stats, frameScale);
         timedSize = size;
       }
 

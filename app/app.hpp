@@ -23,7 +23,9 @@ struct AppOptions {
   int width = 1280;
   int height = 800;
   std::optional<int> threads;  // simulation threads; by default every core (at most 8)
-  bool timings = false;        // at exit, print the median cost of a frame's parts to stdout
+  std::optional<double>
+      renderScale;       // the scene's fraction of the window's size, fixed; by default chosen to keep 60 fps
+  bool timings = false;  // at exit, print the median cost of a frame's parts to stdout
 };
 
 int runApp(const AppOptions& options);

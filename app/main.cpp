@@ -21,6 +21,10 @@ int main(int argc, char** argv) {
   cli.add_option("--height", options.height, "Window height in points")->check(CLI::Range(64, 16384));
   cli.add_option("--threads", options.threads, "Simulation threads (default: every core, at most 8)")
       ->check(CLI::Range(1, 8));
+  cli.add_option("--render-scale", options.renderScale,
+                 "Draw the scene at this fraction of the window's width and height, 0.5 to 1 (default: as many "
+                 "pixels as keep 60 fps)")
+      ->check(CLI::Range(0.5, 1.0));
   cli.add_flag("--timings", options.timings,
                "At exit, print the median milliseconds of a frame and of its parts (simulation, scene, panels, swap)");
   try {

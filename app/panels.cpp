@@ -156,8 +156,9 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
   ImGui::Text("simulation %.1f ms (%d steps), drawing %.1f ms per frame", stats.simulationSeconds * 1e3, stats.steps,
               stats.drawSeconds * 1e3);
   if (display.x >= 1000.0f) {  // the detail, where there is room for it (the parts of the same frame)
-    ImGui::Text("  drawing: scene %.1f ms, panels %.1f ms, presenting %.1f ms", stats.sceneSeconds * 1e3,
-                stats.panelSeconds * 1e3, stats.swapSeconds * 1e3);
+    ImGui::Text("  drawing: scene %.1f ms (at %.0f %% of the window%s), panels %.1f ms, presenting %.1f ms",
+                stats.sceneSeconds * 1e3, panels.renderScale.scale() * 100.0,
+                panels.renderScale.automatic() ? ", auto" : "", stats.panelSeconds * 1e3, stats.swapSeconds * 1e3);
   }
   if (fps > 0.0 && fps < 55.0) {
     // Say why, in the terms the user can act on.
@@ -321,6 +322,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   }
   if (!panels.showPanels) {  // Tab: a clean view of the scene, no HUD, no panel
     panels.panelWidth = 0.0f;
+    panels.hiddenRight = 0.0f;
     if (panels.showHelp) help(panels);
     return toLoad;
   }
@@ -347,9 +349,17 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       panels.collapsedBySize = small;
     }
   }
+  ImGui::SetNextWindowBgAlpha(1.0f);  // opaque: the scene behind it is not drawn
   ImGui::Begin("Drape");
   noteWindow(panels);
   panels.panelWidth = ImGui::IsWindowCollapsed() ? 0.0f : ImGui::GetWindowSize().x + 10.0f;
+  {
+    const ImVec2 at = ImGui::GetWindowPos(), extent = ImGui::GetWindowSize();
+    constexpr float kSlack = 12.0f;  // the margin it is placed with, and a little more
+    const bool againstTheEdge = at.x + extent.x >= display.x - kSlack && at.y <= kSlack &&
+                                at.y + extent.y >= display.y - kSlack && at.x >= 0.0f;
+    panels.hiddenRight = !ImGui::IsWindowCollapsed() && againstTheEdge ? display.x - at.x : 0.0f;
+  }
   // Widgets leave room on their right for the longest label.
   ImGui::PushItemWidth(-std::min(ImGui::CalcTextSize("pinch distance (m) ").x, ImGui::GetWindowWidth() * 0.42f));
 
@@ -567,6 +577,17 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::SameLine();
     ImGui::Checkbox("4x MSAA", &panels.frameOptions.multisample);
     tip("true antialiasing, four samples a pixel: costly on a software renderer (replaces FXAA while on)");
+    bool automatic = panels.renderScale.automatic();
+    if (ImGui::Checkbox("auto resolution", &automatic)) panels.renderScale.setAutomatic(automatic);
+    tip("draw the scene at as many pixels as keep 60 fps (down to half the window's width and height),\n"
+        "stretched over the window; the panels stay sharp. A software renderer pays for every pixel");
+    float scale = static_cast<float>(panels.renderScale.scale()) * 100.0f;
+    if (ImGui::SliderFloat("resolution (%)", &scale, render::FrameOptions::kLowestRenderScale * 100.0f, 100.0f,
+                           "%.0f")) {
+      panels.renderScale.setAutomatic(false);
+      panels.renderScale.set(scale / 100.0f);
+    }
+    tip("the scene's width and height in per cent of the window's; set by hand, auto resolution turns off");
     ImGui::SliderInt("shadow softness", &panels.frameOptions.shadowSoftness, 0, 3);
     ImGui::SliderInt("shadow map", &panels.frameOptions.shadowMapSize, 256, 4096);
   }

@@ -9,6 +9,7 @@
 
 #include "drape/render/renderer.hpp"
 #include "input.hpp"
+#include "render_scale.hpp"
 #include "session.hpp"
 
 namespace drape::app {
@@ -69,7 +70,11 @@ struct PanelState {
   // The panels' windows as they were last drawn, in normalised window coordinates: an event over
   // one goes to the panels (overAny), decided for each event as it comes.
   std::vector<ScreenRect> windows;
-  float panelWidth = 0.0f;                                    // points, of the main panel as last drawn (0 when hidden)
+  float panelWidth = 0.0f;  // points, of the main panel as last drawn (0 when hidden)
+  // Points at the window's right edge the main panel (opaque) hid as last drawn: from its left edge
+  // to the window's, while it stands against that edge top to bottom; 0 otherwise. The scene is not
+  // drawn there (FrameOptions::hiddenRight).
+  float hiddenRight = 0.0f;
   float lastDisplayWidth = -1.0f, lastDisplayHeight = -1.0f;  // the panel is placed again when these change
   bool collapsedBySize = false;  // the panel was collapsed because the window was too small
   bool showHelp = false;
@@ -89,6 +94,9 @@ struct PanelState {
     options.shadowMapSize = 1024;
     return options;
   }();
+  // The fraction of the window's width and height the scene is drawn at: chosen from the frames'
+  // cost to keep 60 fps unless set by hand (View panel, --render-scale).
+  RenderScale renderScale;
   History maxStrain, meanStrain, energy;
   // Intersecting triangle pairs (sim/intersections.hpp), counted every kIntersectionFrames frames:
   // a count costs about a pass over the triangles, too much to take every frame on a fine cloth.

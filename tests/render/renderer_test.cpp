@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "context.hpp"
 #include "drape/render/renderer.hpp"
@@ -248,6 +249,76 @@ TEST_F(RendererTest, FxaaFiltersEachFrameFromThatFramesPicture) {
   for (std::size_t i = 0; i < first.size(); ++i) differing += first[i] != second[i];
   EXPECT_EQ(differing, 0);
   EXPECT_GT(blended(second, options), 40);  // and it was filtered
+}
+
+TEST_F(RendererTest, AtHalfScaleTheSceneIsDrawnSmallerAndStretchedOverTheSamePixels) {
+  // The same sheet at render scale 1 and 0.5 covers the same part of the picture (to its stretched
+  // edges); the half-scale picture is not the full one (it was drawn at a quarter of the pixels
+  // and filtered up), and a scale that is not a number draws at the lowest scale, not at none.
+  const sim::World world(sheet(1.0));
+  Camera camera = fromAbove(1.0);
+  camera.yaw = 0.52;
+  camera.distance = 3.2;
+  FrameOptions options;
+  options.woven = false;
+  options.multisample = false;
+  const auto cloth = [](const std::vector<std::uint8_t>& rgba) {
+    int count = 0;
+    for (std::size_t i = 0; i < rgba.size(); i += 4) count += rgba[i] > 150 && rgba[i] > 1.8 * rgba[i + 2];
+    return count;
+  };
+  renderer_->render(world, camera, kWidth, kHeight, options);
+  const std::vector<std::uint8_t> full = renderer_->readPixels(kWidth, kHeight);
+  options.renderScale = 0.5f;
+  renderer_->render(world, camera, kWidth, kHeight, options);
+  const std::vector<std::uint8_t> half = renderer_->readPixels(kWidth, kHeight);
+  options.renderScale = std::numeric_limits<float>::quiet_NaN();
+  renderer_->render(world, camera, kWidth, kHeight, options);
+  const std::vector<std::uint8_t> unnamed = renderer_->readPixels(kWidth, kHeight);
+  EXPECT_GT(cloth(full), 600);
+  EXPECT_NEAR(cloth(half), cloth(full), 0.1 * cloth(full));
+  EXPECT_NE(half, full);
+  EXPECT_EQ(unnamed, half);
+}
+
+TEST_F(RendererTest, TheHiddenStripIsLeftToTheBackgroundAndTheRestIsAsBefore) {
+  // A panel will cover the right third: the scene (table, sheet and its shadow) is drawn as before
+  // left of it, pixel for pixel, and only the background colour is under it; at half scale too.
+  // Next to the strip, FXAA (6 pixels, 12 at half scale) and the stretch's filter see it.
+  sim::WorldSettings settings = sheet(0.3);
+  settings.colliders.push_back(sim::ColliderSettings{});
+  const sim::World world(settings);
+  Camera camera = fromAbove(1.0);
+  camera.pitch = 0.6;
+  FrameOptions options;
+  options.multisample = false;
+  constexpr int kHidden = kWidth / 3;
+  for (const float scale : {1.0f, 0.5f}) {
+    options.renderScale = scale;
+    options.hiddenRight = 0;
+    renderer_->render(world, camera, kWidth, kHeight, options);
+    const std::vector<std::uint8_t> whole = renderer_->readPixels(kWidth, kHeight);
+    options.hiddenRight = kHidden;
+    renderer_->render(world, camera, kWidth, kHeight, options);
+    const std::vector<std::uint8_t> hidden = renderer_->readPixels(kWidth, kHeight);
+    const glm::vec3 background = options.backgroundColour * 255.0f;
+    int changedLeft = 0, sceneRight = 0, differentRight = 0;
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const std::size_t i = static_cast<std::size_t>((y * kWidth + x) * 4);
+        const glm::vec3 c(hidden[i], hidden[i + 1], hidden[i + 2]);
+        if (x < kWidth - kHidden - 14) {
+          changedLeft += hidden[i] != whole[i] || hidden[i + 1] != whole[i + 1] || hidden[i + 2] != whole[i + 2];
+        } else if (x >= kWidth - kHidden) {
+          sceneRight += glm::length(c - background) > 1.5f;
+          differentRight += hidden[i] != whole[i];
+        }
+      }
+    }
+    EXPECT_EQ(changedLeft, 0) << "scale " << scale;
+    EXPECT_EQ(sceneRight, 0) << "scale " << scale;
+    EXPECT_GT(differentRight, kHidden * kHeight / 2) << "scale " << scale;  // the table was there
+  }
 }
 
 }  // namespace

@@ -311,6 +311,11 @@ struct Renderer::Impl {
   int pictureWidth = 0, pictureHeight = 0;
   GLuint shadowFramebuffer = 0, shadowTexture = 0;
   GLuint sampleFramebuffer = 0, sampleColour = 0, sampleDepth = 0;
+  // The scene drawn at a fraction of the picture's size (FrameOptions::renderScale), stretched over it.
+  GLuint scaledFramebuffer = 0, scaledColour = 0, scaledDepth = 0;
+  int scaledWidth = 0, scaledHeight = 0;
+  bool scaledComplete = false;
+  float pixelScale = 1.0f;  // the picture's pixels per pixel of the caller's: markers keep their size on screen
   int sampleWidth = 0, sampleHeight = 0, samples = 0;
   int shadowMapSize = 0;
   GLuint groundVao = 0, groundBuffer = 0;
@@ -427,6 +432,27 @@ struct Renderer::Impl {
     shadowMapSize = size;
     glBindTexture(GL_TEXTURE_2D, shadowTexture);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, nullptr);
+  }
+
+  // False where the context cannot make it (then the scene is drawn at full size).
+  bool ensureScaledTarget(int width, int height) {
+    if (scaledFramebuffer && width == scaledWidth && height == scaledHeight) return scaledComplete;
+    if (!scaledFramebuffer) {
+      glGenFramebuffers(1, &scaledFramebuffer);
+      glGenRenderbuffers(1, &scaledColour);
+      glGenRenderbuffers(1, &scaledDepth);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, scaledColour);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, scaledDepth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, scaledFramebuffer);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, scaledColour);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, scaledDepth);
+    scaledComplete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    scaledWidth = width;
+    scaledHeight = height;
+    return scaledComplete;
   }
 
   void ensureSampleTarget(int width, int height) {
@@ -566,6 +592,9 @@ Renderer::~Renderer() {
   glDeleteFramebuffers(1, &r.shadowFramebuffer);
   glDeleteTextures(1, &r.shadowTexture);
   glDeleteFramebuffers(1, &r.sampleFramebuffer);
+  glDeleteFramebuffers(1, &r.scaledFramebuffer);
+  glDeleteRenderbuffers(1, &r.scaledColour);
+  glDeleteRenderbuffers(1, &r.scaledDepth);
   glDeleteRenderbuffers(1, &r.sampleColour);
   glDeleteRenderbuffers(1, &r.sampleDepth);
   glDeleteVertexArrays(1, &r.groundVao);
@@ -583,6 +612,38 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   if (width <= 0 || height <= 0) return;  // a minimised window: nothing to draw
   GLint target = 0;
   glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
+
+  // At a render scale under 1 the scene is drawn smaller, into a picture of its own, and stretched
+  // (linearly filtered) over the caller's: a software rasteriser pays per pixel.
+  const float scale = options.renderScale >= FrameOptions::kLowestRenderScale
+                          ? std::min(options.renderScale, 1.0f)
+                          : FrameOptions::kLowestRenderScale;  // a NaN too
+  const int scaledWidth = std::max(1, static_cast<int>(std::lround(static_cast<double>(width) * scale)));
+  const int scaledHeight = std::max(1, static_cast<int>(std::lround(static_cast<double>(height) * scale)));
+  if ((scaledWidth < width || scaledHeight < height) && r.ensureScaledTarget(scaledWidth, scaledHeight)) {
+    FrameOptions full = options;
+    full.renderScale = 1.0f;
+    full.hiddenRight =
+        static_cast<int>(std::lround(static_cast<double>(std::clamp(options.hiddenRight, 0, width)) * scale));
+    glBindFramebuffer(GL_FRAMEBUFFER, r.scaledFramebuffer);
+    r.pixelScale = static_cast<float>(scaledHeight) / static_cast<float>(height);
+    render(world, camera, scaledWidth, scaledHeight, full, overlay);
+    r.pixelScale = 1.0f;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r.scaledFramebuffer);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
+    glViewport(0, 0, width, height);
+    const int shown = width - std::clamp(options.hiddenRight, 0, width);
+    if (shown < width) {  // the hidden strip gets the background colour, the blit spares it
+      glClearColor(options.backgroundColour.r, options.backgroundColour.g, options.backgroundColour.b, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT);
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(0, 0, shown, height);
+    }
+    glBlitFramebuffer(0, 0, scaledWidth, scaledHeight, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    glDisable(GL_SCISSOR_TEST);
+    glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(target));
+    return;
+  }
 
   if (world.topologyVersion() != r.topologyVersion || r.cloths.size() != world.cloths().size()) {
     r.uploadTopology(world);
@@ -663,6 +724,13 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glViewport(0, 0, width, height);
   glClearColor(options.backgroundColour.r, options.backgroundColour.g, options.backgroundColour.b, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  // What is drawn from here on stays left of the hidden strip: a software rasteriser skips the
+  // tiles a scissor leaves out.
+  const int shown = width - std::clamp(options.hiddenRight, 0, width);
+  if (shown < width) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, 0, shown, height);
+  }
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, r.shadowTexture);
 
@@ -767,7 +835,7 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
       static_cast<float>(height / (2.0 * std::tan(camera.fieldOfView / 2.0) * camera.distance));
   if (options.particles) {  // every particle of a sheet as a dot, a few pixels wide
     glUniform1i(uniform(r.overlayProgram, "roundPoints"), 1);
-    glUniform1f(uniform(r.overlayProgram, "pointSize"), 5.0f);
+    glUniform1f(uniform(r.overlayProgram, "pointSize"), 5.0f * r.pixelScale);
     glVertexAttrib4f(1, 0.95f, 0.95f, 0.95f, 1.0f);
     for (const GpuCloth& gpu : r.cloths) {
       if (gpu.chain) continue;
@@ -782,7 +850,8 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
       r.overlayScratch.push_back({glm::vec3(x), glm::vec4(options.frontColour, 1.0f)});
   }
   glUniform1i(uniform(r.overlayProgram, "roundPoints"), 1);
-  glUniform1f(uniform(r.overlayProgram, "pointSize"), std::clamp(pixelsPerMetre * 0.03f, 4.0f, 24.0f));
+  glUniform1f(uniform(r.overlayProgram, "pointSize"),
+              std::clamp(pixelsPerMetre * 0.03f, 4.0f * r.pixelScale, 24.0f * r.pixelScale));
   r.drawOverlay(r.overlayScratch, GL_POINTS);
 
   glDisable(GL_DEPTH_TEST);  // markers stay visible through the cloth
@@ -803,11 +872,12 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   }
   r.overlayScratch.insert(r.overlayScratch.end(), overlay.points.begin(), overlay.points.end());
   glUniform1i(uniform(r.overlayProgram, "roundPoints"), 1);
-  glUniform1f(uniform(r.overlayProgram, "pointSize"), 11.0f);
+  glUniform1f(uniform(r.overlayProgram, "pointSize"), 11.0f * r.pixelScale);
   r.drawOverlay(r.overlayScratch, GL_POINTS);
   glEnable(GL_DEPTH_TEST);
 
-  if (multisample && r.samples > 0) {  // resolve into the caller's framebuffer
+  glDisable(GL_SCISSOR_TEST);
+  if (multisample && r.samples > 0) {  // resolve into the caller's framebuffer (the hidden strip too: cleared)
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r.sampleFramebuffer);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(target));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
@@ -830,7 +900,7 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
     if (x1 > x0 && y1 > y0) glCopyTexSubImage2D(GL_TEXTURE_2D, 0, x0, y0, x0, y0, x1 - x0, y1 - y0);
     glViewport(0, 0, width, height);
     glEnable(GL_SCISSOR_TEST);
-    glScissor(covered[0], covered[1], covered[2], covered[3]);
+    glScissor(covered[0], covered[1], std::max(0, std::min(covered[2], shown - covered[0])), covered[3]);
     glDisable(GL_DEPTH_TEST);
     glUseProgram(r.fxaaProgram);
     glActiveTexture(GL_TEXTURE0);

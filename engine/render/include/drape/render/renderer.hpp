@@ -60,6 +60,14 @@ struct FrameOptions {
   bool fxaa = true;          // without MSAA: FXAA, one cheap filter pass over the picture
   int shadowSoftness = 3;    // 0..3: shadow filter taps (2s+1)^2 on the table; a software renderer pays for each
   int shadowMapSize = 2048;  // texels a side, 256..4096
+  // The scene is drawn at this fraction of the picture's width and height and stretched over it
+  // (dynamic resolution: a software renderer pays per pixel); 1 draws every pixel. Clamped to
+  // [kLowestRenderScale, 1].
+  float renderScale = 1.0f;
+  static constexpr float kLowestRenderScale = 0.5f;
+  // Pixels at the picture's right edge that something opaque drawn afterwards covers (the app's
+  // panel): the scene is not drawn there, only the background colour.
+  int hiddenRight = 0;
   glm::vec3 frontColour{0.85f, 0.33f, 0.18f};
   glm::vec3 backColour{0.20f, 0.52f, 0.62f};
   glm::vec3 backgroundColour{0.62f, 0.66f, 0.70f};
