@@ -4,14 +4,18 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <thread>
 
 #include <backends/imgui_impl_opengl3.h>
@@ -20,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/interact/replay.hpp"
+#include "drape/render/layer.hpp"
 #include "drape/render/renderer.hpp"
 #include "drape/scene/error.hpp"
 #include "drape/scene/gesture.hpp"
@@ -69,6 +74,69 @@ struct TimingLog {
     return line;
   }
 };
+
+// What a draw list would put on the screen: its vertices, indices and commands, and the display
+// they are drawn on. Two lists with the same key draw the same pixels.
+std::uint64_t drawKey(const ImDrawList& list, const ImDrawData& data) {
+  const auto bytes = [](const void* p, std::size_t n) {
+    return std::hash<std::string_view>{}(std::string_view(static_cast<const char*>(p), n));
+  };
+  std::uint64_t key = bytes(list.VtxBuffer.Data, static_cast<std::size_t>(list.VtxBuffer.Size) * sizeof(ImDrawVert));
+  const auto mix = [&key](std::uint64_t h) { key ^= h + 0x9e3779b97f4a7c15ULL + (key << 6) + (key >> 2); };
+  mix(bytes(list.IdxBuffer.Data, static_cast<std::size_t>(list.IdxBuffer.Size) * sizeof(ImDrawIdx)));
+  for (const ImDrawCmd& cmd : list.CmdBuffer) {
+    const float clip[4] = {cmd.ClipRect.x, cmd.ClipRect.y, cmd.ClipRect.z, cmd.ClipRect.w};
+    mix(bytes(clip, sizeof clip));
+    mix(reinterpret_cast<std::uintptr_t>(cmd.TextureId));
+    mix((static_cast<std::uint64_t>(cmd.ElemCount) << 32) ^ (static_cast<std::uint64_t>(cmd.IdxOffset) << 16) ^
+        cmd.VtxOffset);
+  }
+  const float display[6] = {data.DisplayPos.x,  data.DisplayPos.y,       data.DisplaySize.x,
+                            data.DisplaySize.y, data.FramebufferScale.x, data.FramebufferScale.y};
+  mix(bytes(display, sizeof display));
+  return key;
+}
+
+// Draws ImGui's lists, the main panel's from `layer`: drawn into it only when the panel's list
+// changed (a hover, a value, a resize), and otherwise copied from it, which on llvmpipe costs a
+// fraction of drawing its 300,000 blended pixels again. The panel is opaque and its rectangle is
+// copied whole, so the lists before it (under it) and after it (over it) are drawn as ImGui would.
+void drawImGui(ImDrawData* data, const PanelState& panels, render::Layer& layer, int pixelsWide, int pixelsHigh) {
+  int panel = -1;
+  for (int i = 0; i < data->CmdListsCount; ++i) {
+    if (data->CmdLists[i] == panels.panelDrawList) panel = i;
+  }
+  if (panel < 0 || pixelsWide <= 0 || pixelsHigh <= 0) {
+    layer.invalidate();
+    ImGui_ImplOpenGL3_RenderDrawData(data);
+    return;
+  }
+  const auto drawLists = [data](int first, int last) {
+    if (last <= first) return;
+    ImDrawData part = *data;
+    part.CmdLists = data->CmdLists + first;
+    part.CmdListsCount = last - first;
+    ImGui_ImplOpenGL3_RenderDrawData(&part);
+  };
+  drawLists(0, panel);
+  const std::uint64_t key = drawKey(*data->CmdLists[panel], *data);
+  if (!layer.holds(key, pixelsWide, pixelsHigh)) {
+    if (!layer.begin(key, pixelsWide, pixelsHigh)) {  // no layer here: drawn as ImGui would
+      drawLists(panel, data->CmdListsCount);
+      return;
+    }
+    drawLists(panel, panel + 1);
+    layer.end();
+  }
+  // The panel's rectangle in pixels from the bottom left, rounded outwards.
+  const float sx = data->FramebufferScale.x, sy = data->FramebufferScale.y;
+  const int x0 = static_cast<int>(std::floor((panels.panelRect[0] - data->DisplayPos.x) * sx));
+  const int x1 = static_cast<int>(std::ceil((panels.panelRect[0] + panels.panelRect[2] - data->DisplayPos.x) * sx));
+  const int top = static_cast<int>(std::floor((panels.panelRect[1] - data->DisplayPos.y) * sy));
+  const int bottom = static_cast<int>(std::ceil((panels.panelRect[1] + panels.panelRect[3] - data->DisplayPos.y) * sy));
+  layer.copyTo(x0, pixelsHigh - bottom, x1 - x0, bottom - top);
+  drawLists(panel + 1, data->CmdListsCount);
+}
 
 // The touch device replayed scripts speak through.
 constexpr SDL_TouchID kReplayTouch = 4242;
@@ -406,6 +474,7 @@ int runApp(const AppOptions& options) {
 
     ImGuiMouse imguiMouse;
     PanelState panels;
+    render::Layer panelLayer;  // the main panel's picture (drawImGui)
     if (options.renderScale) {
       panels.renderScale.setAutomatic(false);
       panels.renderScale.set(*options.renderScale);
@@ -553,7 +622,7 @@ int runApp(const AppOptions& options) {
         const std::optional<std::filesystem::path> toLoad = drawPanels(*session, panels, stats, *input);
         stats.sceneSeconds = sceneSeconds;
         ImGui::Render();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        drawImGui(ImGui::GetDrawData(), panels, panelLayer, size.pixelsWide, size.pixelsHigh);
         session->setView(size.aspect(), size.width > 0 ? panels.panelWidth / static_cast<float>(size.width) : 0.0);
         if (!framed && panels.panelWidth > 0.0f) {
           session->resetView();  // now that the panel's width is known: the scene beside it

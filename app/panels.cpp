@@ -323,6 +323,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   if (!panels.showPanels) {  // Tab: a clean view of the scene, no HUD, no panel
     panels.panelWidth = 0.0f;
     panels.hiddenRight = 0.0f;
+    panels.panelDrawList = nullptr;
     if (panels.showHelp) help(panels);
     return toLoad;
   }
@@ -359,6 +360,11 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     const bool againstTheEdge = at.x + extent.x >= display.x - kSlack && at.y <= kSlack &&
                                 at.y + extent.y >= display.y - kSlack && at.x >= 0.0f;
     panels.hiddenRight = !ImGui::IsWindowCollapsed() && againstTheEdge ? display.x - at.x : 0.0f;
+    panels.panelDrawList = ImGui::IsWindowCollapsed() ? nullptr : ImGui::GetWindowDrawList();
+    panels.panelRect[0] = at.x;
+    panels.panelRect[1] = at.y;
+    panels.panelRect[2] = extent.x;
+    panels.panelRect[3] = extent.y;
   }
   // Widgets leave room on their right for the longest label.
   ImGui::PushItemWidth(-std::min(ImGui::CalcTextSize("pinch distance (m) ").x, ImGui::GetWindowWidth() * 0.42f));

@@ -12,6 +12,8 @@
 #include "render_scale.hpp"
 #include "session.hpp"
 
+struct ImDrawList;
+
 namespace drape::app {
 
 enum class KeyAction : std::uint8_t {
@@ -75,6 +77,11 @@ struct PanelState {
   // to the window's, while it stands against that edge top to bottom; 0 otherwise. The scene is not
   // drawn there (FrameOptions::hiddenRight).
   float hiddenRight = 0.0f;
+  // The main panel's draw list and rectangle (points: x, y from the top left, width, height) as
+  // last drawn, while it is open and opaque (null otherwise): the app keeps its picture in a layer
+  // and draws it again only when the list changed.
+  const ImDrawList* panelDrawList = nullptr;
+  float panelRect[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   float lastDisplayWidth = -1.0f, lastDisplayHeight = -1.0f;  // the panel is placed again when these change
   bool collapsedBySize = false;  // the panel was collapsed because the window was too small
   bool showHelp = false;

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "context.hpp"
+#include "drape/render/layer.hpp"
 #include "drape/render/renderer.hpp"
 #include "drape/sim/world.hpp"
 
@@ -319,6 +320,51 @@ TEST_F(RendererTest, TheHiddenStripIsLeftToTheBackgroundAndTheRestIsAsBefore) {
     EXPECT_EQ(sceneRight, 0) << "scale " << scale;
     EXPECT_GT(differentRight, kHidden * kHeight / 2) << "scale " << scale;  // the table was there
   }
+}
+
+TEST_F(RendererTest, ALayerKeepsItsPictureAndCopiesARectangleOfItToTheSamePlace) {
+  // A sheet drawn into a layer; then the picture bound now shows a scene without it (the table
+  // and sky only) and the layer's left half is copied over it: left half the sheet's picture, the
+  // right half untouched, and the layer still holds it for the key it was drawn with.
+  sim::WorldSettings settings = sheet(0.3);
+  settings.colliders.push_back(sim::ColliderSettings{});
+  const sim::World withSheet(settings);
+  settings.cloths.clear();
+  const sim::World without(settings);
+  const Camera camera = fromAbove(1.0);
+  FrameOptions options;
+  options.multisample = false;
+  renderer_->render(withSheet, camera, kWidth, kHeight, options);
+  const std::vector<std::uint8_t> sheetPicture = renderer_->readPixels(kWidth, kHeight);
+  renderer_->render(without, camera, kWidth, kHeight, options);
+  const std::vector<std::uint8_t> emptyPicture = renderer_->readPixels(kWidth, kHeight);
+  ASSERT_NE(sheetPicture, emptyPicture);
+
+  Layer layer;
+  EXPECT_FALSE(layer.holds(7, kWidth, kHeight));
+  ASSERT_TRUE(layer.begin(7, kWidth, kHeight));
+  renderer_->render(withSheet, camera, kWidth, kHeight, options);
+  layer.end();
+  EXPECT_TRUE(layer.holds(7, kWidth, kHeight));
+  EXPECT_FALSE(layer.holds(8, kWidth, kHeight));
+  EXPECT_FALSE(layer.holds(7, kWidth + 1, kHeight));
+  renderer_->render(without, camera, kWidth, kHeight, options);  // into the picture bound before begin
+  layer.copyTo(0, 0, kWidth / 2, kHeight);
+  const std::vector<std::uint8_t> copied = renderer_->readPixels(kWidth, kHeight);
+  int wrongLeft = 0, wrongRight = 0;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const std::size_t i = static_cast<std::size_t>((y * kWidth + x) * 4);
+      const std::vector<std::uint8_t>& expected = x < kWidth / 2 ? sheetPicture : emptyPicture;
+      const bool same =
+          copied[i] == expected[i] && copied[i + 1] == expected[i + 1] && copied[i + 2] == expected[i + 2];
+      (x < kWidth / 2 ? wrongLeft : wrongRight) += !same;
+    }
+  }
+  EXPECT_EQ(wrongLeft, 0);
+  EXPECT_EQ(wrongRight, 0);
+  layer.invalidate();
+  EXPECT_FALSE(layer.holds(7, kWidth, kHeight));
 }
 
 }  // namespace
