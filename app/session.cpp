@@ -103,41 +103,57 @@ std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const st
 
 // `after` (the cloths as an undo found them, a cut or tear in them) brought to the motion since,
 // from `now` (the cloths before that cut or tear): each particle that was there before it is where
-// it is now, and each copy the cut or tear made keeps its offset from the particle it was split
-// from. A cut or tear keeps the triangles in their order and points some of their corners at the
-// copies (topology.cpp), so a copy's particle is the corner `now` has where `after` has the copy.
-// (A rest position does not name it: an earlier cut's copies share it.) Where the cloths do not
-// match so, `after` as it is.
+// it is now, and each particle the cut or tear made (a copy, or a particle put on an edge) moves as
+// the particles beside it (in `after`'s triangles, on its own side of the cut) moved on average. A
+// cut or tear keeps each particle's index and appends the new ones (topology.cpp). Where the
+// cloths do not match so, `after` as it is.
 std::vector<sim::Cloth> withMotionAfter(std::vector<sim::Cloth> after, const std::vector<sim::Cloth>& now) {
   if (after.size() != now.size()) return after;
   for (std::size_t c = 0; c < after.size(); ++c) {
-    if (after[c].state.position.size() < now[c].state.position.size() ||
-        after[c].rest.triangles.size() != now[c].rest.triangles.size()) {
-      return after;
-    }
+    if (after[c].state.position.size() < now[c].state.position.size()) return after;
   }
   for (std::size_t c = 0; c < after.size(); ++c) {
     sim::ParticleState& s = after[c].state;
     const sim::ParticleState& current = now[c].state;
-    const std::size_t n = current.position.size();
-    std::vector<std::size_t> splitFrom(s.position.size(), n);  // n: not found
-    const std::vector<glm::uvec3>& cornersAfter = after[c].rest.triangles;
-    const std::vector<glm::uvec3>& cornersNow = now[c].rest.triangles;
-    for (std::size_t t = 0; t < cornersAfter.size(); ++t) {
-      for (int k = 0; k < 3; ++k) {
-        const std::size_t copy = cornersAfter[t][k], particle = cornersNow[t][k];
-        if (copy >= n && particle < n && after[c].rest.restOffsets[copy] == after[c].rest.restOffsets[particle]) {
-          splitFrom[copy] = particle;
+    const std::size_t n = current.position.size(), total = s.position.size();
+    // How far each particle has moved since the undo: known for those there before.
+    std::vector<sim::Vec3> moved(total, sim::Vec3{0.0}), movedBefore(total, sim::Vec3{0.0});
+    std::vector<std::uint8_t> known(total, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      moved[i] = current.position[i] - s.position[i];
+      movedBefore[i] = current.previousPosition[i] - s.previousPosition[i];
+      known[i] = 1;
+    }
+    // The new ones from their neighbours, ring by ring (a new particle may touch only new ones).
+    const std::vector<glm::uvec3>& triangles = after[c].rest.triangles;
+    for (bool progress = true; progress;) {
+      progress = false;
+      std::vector<sim::Vec3> sum(total, sim::Vec3{0.0}), sumBefore(total, sim::Vec3{0.0});
+      std::vector<int> count(total, 0);
+      for (const glm::uvec3& t : triangles) {
+        for (int k = 0; k < 3; ++k) {
+          const std::size_t j = t[k];
+          if (j >= total || known[j]) continue;
+          for (int e = 1; e < 3; ++e) {
+            const std::size_t i = t[(k + e) % 3];
+            if (i >= total || !known[i]) continue;
+            sum[j] += moved[i];
+            sumBefore[j] += movedBefore[i];
+            ++count[j];
+          }
         }
       }
+      for (std::size_t j = n; j < total; ++j) {
+        if (known[j] || count[j] == 0) continue;
+        moved[j] = sum[j] / static_cast<double>(count[j]);
+        movedBefore[j] = sumBefore[j] / static_cast<double>(count[j]);
+        known[j] = 1;
+        progress = true;
+      }
     }
-    const std::vector<sim::Vec3> position = s.position, previous = s.previousPosition;
-    for (std::size_t j = n; j < s.position.size(); ++j) {
-      const std::size_t i = splitFrom[j];
-      if (i >= n) continue;
-      s.position[j] = current.position[i] + (position[j] - position[i]);
-      s.previousPosition[j] = current.previousPosition[i] + (previous[j] - previous[i]);
-      if (j < s.velocity.size() && i < current.velocity.size()) s.velocity[j] = current.velocity[i];
+    for (std::size_t j = n; j < total; ++j) {
+      s.position[j] += moved[j];
+      s.previousPosition[j] += movedBefore[j];
     }
     takeMotion(s, current, n);
   }

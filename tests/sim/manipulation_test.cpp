@@ -315,6 +315,149 @@ TEST(Cutting, ASwipeAcrossTheSheetMakesTwoPiecesThatMoveApart) {
   EXPECT_GT(nearLowest, 0.1);
 }
 
+// The particles on the border of a flat sheet's mesh (on an edge of one triangle only) that are not
+// on the sheet's own border (0 and 1 in x and z): the border a cut or tear made.
+std::vector<Vec3> madeBorder(const Cloth& cloth) {
+  std::vector<std::pair<ParticleIndex, ParticleIndex>> edges;
+  for (const glm::uvec3& t : cloth.rest.triangles) {
+    for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(t[k], t[(k + 1) % 3]));
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::uint8_t> border(cloth.state.position.size(), 0);
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) border[edges[i].first] = border[edges[i].second] = 1;
+    i = j;
+  }
+  std::vector<Vec3> made;
+  for (std::size_t i = 0; i < border.size(); ++i) {
+    const Vec3 x = cloth.rest.restPosition(i);
+    const bool outer = std::min({x.x, x.z, 1.0 - x.x, 1.0 - x.z}) < 1e-6;
+    if (border[i] && !outer) made.push_back(cloth.state.position[i]);
+  }
+  return made;
+}
+
+// The distance from x to a polyline in the table's plane (x and z).
+Real distanceToPath(Vec3 x, const std::vector<Vec3>& path) {
+  Real best = 1e300;
+  for (std::size_t k = 0; k + 1 < path.size(); ++k) {
+    const glm::dvec2 p{x.x, x.z}, a{path[k].x, path[k].z}, b{path[k + 1].x, path[k + 1].z};
+    const Real t = std::clamp(glm::dot(p - a, b - a) / glm::dot(b - a, b - a), 0.0, 1.0);
+    best = std::min(best, glm::length(p - (a + t * (b - a))));
+  }
+  return best;
+}
+
+// Every triangle's smallest angle at rest, in degrees, the least of them; and whether all face one way.
+Real smallestAngle(const Cloth& cloth, bool& oneWay) {
+  Real least = 180.0;
+  oneWay = true;
+  for (const glm::uvec3& t : cloth.rest.triangles) {
+    const Vec3 p[3] = {cloth.rest.restPosition(t[0]), cloth.rest.restPosition(t[1]), cloth.rest.restPosition(t[2])};
+    if (!(glm::cross(p[1] - p[0], p[2] - p[0]).y > 0.0)) oneWay = false;  // counter-clockwise from +y
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 u = glm::normalize(p[(k + 1) % 3] - p[k]), v = glm::normalize(p[(k + 2) % 3] - p[k]);
+      least = std::min(least, std::acos(std::clamp(glm::dot(u, v), -1.0, 1.0)) * 180.0 / 3.141592653589793);
+    }
+  }
+  return least;
+}
+
+Real shortestEdge(const Cloth& cloth) {
+  Real least = 1e300;
+  for (const glm::uvec3& t : cloth.rest.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      least = std::min(least, glm::length(cloth.rest.restPosition(t[(k + 1) % 3]) - cloth.rest.restPosition(t[k])));
+    }
+  }
+  return least;
+}
+
+TEST(Cutting, ADiagonalCutLeavesItsBorderOnTheSwipeNotAStaircase) {
+  // A slope the lattice has no edges along. Cutting along lattice edges left a staircase whose
+  // teeth stood up to a spacing off the line; through the triangles, every border point is on it.
+  const int n = 21;
+  const Real h = 1.0 / (n - 1);
+  World world(flatSheet(n));
+  const std::vector<Vec3> swipe{Vec3{-0.2, 0.0, 0.1}, Vec3{1.2, 0.0, 0.83}};
+  ASSERT_EQ(world.cut(swipe[0], swipe[1], Vec3{0.0, -1.0, 0.0}), 1);
+  const Cloth& cloth = world.cloths()[0];
+  EXPECT_EQ(cloth.pieceCount, 2u);
+  const std::vector<Vec3> border = madeBorder(cloth);
+  ASSERT_GT(border.size(), 2u * static_cast<std::size_t>(n));
+  for (const Vec3& x : border) EXPECT_LT(distanceToPath(x, swipe), 0.1 * h) << x.x << " " << x.z;
+  EXPECT_NEAR(totalMass(world), totalMass(World(flatSheet(n))), 1e-15);
+  bool oneWay = false;
+  EXPECT_GE(smallestAngle(cloth, oneWay), 10.0);
+  EXPECT_TRUE(oneWay);
+  EXPECT_GE(shortestEdge(cloth), 0.2 * h);
+}
+
+TEST(Cutting, ACurvedSwipeCutsAlongItsPathAndEitherPieceLiftsAlone) {
+  // An arc across the sheet swiped in 40 steps, as a finger draws it: each step's segment carries
+  // the cut on from where the last one left it inside a triangle.
+  const int n = 31;
+  const Real h = 1.0 / (n - 1);
+  World world(flatSheet(n));
+  std::vector<Vec3> swipe;
+  for (int k = 0; k <= 40; ++k) {
+    const Real angle = 3.141592653589793 * (0.15 + 0.7 * k / 40.0);
+    swipe.push_back(Vec3{0.5 - 0.9 * std::cos(angle), 0.0, -0.35 + 0.9 * std::sin(angle)});
+  }
+  for (std::size_t k = 0; k + 1 < swipe.size(); ++k) world.cut(swipe[k], swipe[k + 1], Vec3{0.0, -1.0, 0.0});
+  const Cloth& cloth = world.cloths()[0];
+  ASSERT_EQ(cloth.pieceCount, 2u);
+  const std::vector<Vec3> border = madeBorder(cloth);
+  ASSERT_GT(border.size(), 2u * static_cast<std::size_t>(n));
+  for (const Vec3& x : border) EXPECT_LT(distanceToPath(x, swipe), 0.1 * h) << x.x << " " << x.z;
+  EXPECT_NEAR(totalMass(world), totalMass(World(flatSheet(n))), 1e-15);
+  bool oneWay = false;
+  EXPECT_GE(smallestAngle(cloth, oneWay), 10.0);
+  EXPECT_TRUE(oneWay);
+  // Lift the piece inside the arc by its middle: the other stays on the table.
+  const ParticleIndex inside = cloth.rest.index(n / 2, n - 1), outside = cloth.rest.index(n / 2, 0);
+  ASSERT_NE(cloth.pieceOf(inside), cloth.pieceOf(outside));
+  ASSERT_GT(world.pressFinger(1, cloth.state.position[inside], 0.1), 0);
+  world.moveFinger(1, cloth.state.position[inside] + Vec3{0.0, 0.4, 0.0});
+  ASSERT_EQ(world.run(30), StepStatus::ok);
+  Real lowest = 1.0, highest = -1.0;
+  for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+    if (cloth.pieceOf(i) == cloth.pieceOf(inside))
+      lowest = std::min(lowest, cloth.state.position[i].y);
+    else
+      highest = std::max(highest, cloth.state.position[i].y);
+  }
+  EXPECT_LT(highest, 1e-9);
+  EXPECT_GT(lowest, 0.05);
+}
+
+TEST(Cutting, ManyCrossingCutsLeaveNoTriangleFoldedOrEmptyAndTheMassAsItWas) {
+  // 300 random swipes of 3 segments over one sheet, most crossing earlier cuts: every triangle
+  // still faces the way it did with an area, the mass is what it was, and the shreds simulate.
+  const int n = 16;
+  World world(flatSheet(n, Vec3{0.0, -9.81, 0.0}));
+  const Real mass = totalMass(world);
+  std::uint64_t random = 12345;
+  const auto next = [&] {
+    random = random * 6364136223846793005ull + 1442695040888963407ull;
+    return -0.2 + 1.4 * static_cast<Real>(random >> 11) / 9007199254740992.0;
+  };
+  for (int i = 0; i < 300; ++i) {
+    const Vec3 a{next(), 0.0, next()}, b{next(), 0.0, next()};
+    for (int k = 0; k < 3; ++k) world.cut(a + (b - a) * (k / 3.0), a + (b - a) * ((k + 1) / 3.0), Vec3{0.0, -1.0, 0.0});
+  }
+  const Cloth& cloth = world.cloths()[0];
+  EXPECT_GT(cloth.pieceCount, 100u);
+  EXPECT_EQ(totalMass(world), mass);
+  bool oneWay = false;
+  EXPECT_GT(smallestAngle(cloth, oneWay), 0.5);
+  EXPECT_TRUE(oneWay);
+  EXPECT_GT(shortestEdge(cloth), 0.0);
+  ASSERT_EQ(world.run(10), StepStatus::ok);
+}
+
 TEST(Cutting, ASwipeThatStopsInsideLeavesASlitNotTwoPieces) {
   World world(flatSheet(21));
   world.cut(Vec3{-0.2, 0.0, 0.51}, Vec3{0.5, 0.0, 0.51}, Vec3{0.0, -1.0, 0.0});

@@ -1124,10 +1124,10 @@ TEST(Tethers, NoneReachesAcrossACut) {
   EXPECT_EQ(world.tetherCount(), 2 * freeParticles);
   ASSERT_EQ(world.cut(Vec3{0.001, 1.5, -0.7}, Vec3{0.001, 1.5, 0.7}, Vec3{0.0, -1.0, 0.0}), 1);
   ASSERT_EQ(cloth.pieceCount, 2u);
-  // Each particle is tied to the pin of its own half only. (The cut splits the particles of column
-  // n / 2: each original stays with the left half, and its copy, tied as a particle of the right
-  // half, goes with it.)
-  ASSERT_EQ(cloth.state.position.size(), static_cast<std::size_t>(n * n + n));
+  // Each particle is tied to the pin of its own half only. (The cut runs between columns n / 2 - 1
+  // and n / 2, through the n edges across and the n - 1 diagonals between them: each gets a particle
+  // on the cut, which splits in two, one for each half.)
+  ASSERT_EQ(cloth.state.position.size(), static_cast<std::size_t>(n * n + 2 * (2 * n - 1)));
   EXPECT_EQ(world.tetherCount(), cloth.state.position.size() - 2);
   const ParticleIndex leftPin = cloth.rest.index(0, 0), nextToCut = cloth.rest.index(n / 2 + 1, 0);
   ASSERT_NE(cloth.pieceOf(nextToCut), cloth.pieceOf(leftPin));

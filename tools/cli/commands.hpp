@@ -45,6 +45,7 @@ struct RenderArguments {
   std::optional<std::int64_t> every;   // a picture every K steps ...
   std::optional<std::string> outDir;   // ... into this folder
   bool strain = false;                 // strain colour map
+  bool edges = false;                  // the triangles' edges over the surface
   std::optional<std::string> gesture;  // a gesture script played while running
   bool quiet = false;
 };

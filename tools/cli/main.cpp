@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
   outDir->needs(every);
   renderOut->excludes(every);
   renderCommand->add_flag("--strain", renderArguments.strain, "Colour the cloth by its stretch");
+  renderCommand->add_flag("--edges", renderArguments.edges, "Draw the triangles' edges over the cloth");
   renderCommand->add_option("--gesture", renderArguments.gesture, "Play this gesture script (fingers are drawn)");
   renderCommand->add_flag("--quiet", renderArguments.quiet, "Print nothing on success");
 

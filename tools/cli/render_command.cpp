@@ -118,6 +118,7 @@ int render(const RenderArguments& arguments) {
     }
     render::FrameOptions options;
     options.strainMap = arguments.strain;
+    options.wireframe = arguments.edges;
     const auto picture = [&](const render::Camera& camera) {
       renderer->render(world, camera, width, height, options, fingerOverlay(playback));
       return encodePng(renderer->readPixels(width, height), width, height);

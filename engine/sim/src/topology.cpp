@@ -1,6 +1,8 @@
 #include "topology.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <tuple>
 
@@ -42,8 +44,10 @@ Vec3 restCentroid(const ClothRest& rest, const Triangle& t) {
   return (rest.restPosition(t[0]) + rest.restPosition(t[1]) + rest.restPosition(t[2])) / 3.0;
 }
 
+// The recipes that make constraint c from the triangles. With allowFree, a pair no triangle
+// witnesses gets a free link; without, none.
 void addTemplates(Topology& topology, const ClothRest& rest, const Incidence& incidence, ConstraintKind kind,
-                  const DistanceConstraint& c) {
+                  const DistanceConstraint& c, bool allowFree = true) {
   const auto& triangles = rest.triangles;
   const std::size_t first = topology.templates.size();
   ConstraintTemplate base;
@@ -99,7 +103,7 @@ void addTemplates(Topology& topology, const ClothRest& rest, const Incidence& in
       }
     }
   }
-  if (topology.templates.size() > first) return;
+  if (topology.templates.size() > first || !allowFree) return;
   ConstraintTemplate x = base;
   x.link = ConstraintTemplate::Link::free;
   x.t1 = c.a;
@@ -316,6 +320,19 @@ void build(Cloth& cloth) {
       addTemplates(topology, rest, incidence, kind, c);
     }
   }
+  // The scale a cut snaps at: the median stretch rest length (or of any constraint, or of the edges).
+  std::vector<Real> lengths;
+  for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) lengths.push_back(c.restLength);
+  for (std::size_t k = 0; lengths.empty() && k < kConstraintKindCount; ++k) {
+    for (const DistanceConstraint& c : rest.constraints[k]) lengths.push_back(c.restLength);
+  }
+  for (std::size_t t = 0; lengths.empty() && t < triangles.size(); ++t) {
+    lengths.push_back(glm::length(rest.restPosition(triangles[t][1]) - rest.restPosition(triangles[t][0])));
+  }
+  if (!lengths.empty()) {
+    std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2), lengths.end());
+    topology.spacing = lengths[lengths.size() / 2];
+  }
   topology.built = true;
 }
 
@@ -395,58 +412,455 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
   return true;
 }
 
-bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, std::vector<ParticleSplit>& splits) {
+namespace {
+
+// Cutting through triangles. A particle is on the cut's line when it lies within kOnLine spacings
+// of the cut's plane; every other particle is on one side. An edge whose ends lie on opposite sides
+// gets a new particle where the plane crosses it (so no piece of an edge is shorter than kOnLine
+// spacings), and a particle on the line is moved along one of its edges onto the plane (by at most
+// kOnLine spacings, and at most a quarter of its shortest edge, so none of its triangles folds over).
+constexpr Real kOnLine = 0.3;
+
+Real restEdge(const ClothRest& rest, ParticleIndex a, ParticleIndex b) {
+  return glm::length(rest.restPosition(b) - rest.restPosition(a));
+}
+
+// The smallest angle of a triangle at rest, in radians (0 for a degenerate one).
+Real smallestAngle(const ClothRest& rest, ParticleIndex a, ParticleIndex b, ParticleIndex c) {
+  const Vec3 p[3] = {rest.restPosition(a), rest.restPosition(b), rest.restPosition(c)};
+  Real least = 3.2;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+    const Real lu = glm::length(u), lv = glm::length(v);
+    if (!(lu > 0.0) || !(lv > 0.0)) return 0.0;
+    least = std::min(least, std::acos(std::clamp(glm::dot(u, v) / (lu * lv), -1.0, 1.0)));
+  }
+  return least;
+}
+
+// A new particle at a + s (b - a), at rest and now; its mass is set later (cutMasses).
+ParticleIndex insertParticle(Cloth& cloth, ParticleIndex a, ParticleIndex b, Real s) {
+  ClothRest& rest = cloth.rest;
+  ParticleState& st = cloth.state;
+  const auto p = static_cast<ParticleIndex>(rest.particleCount());
+  const glm::vec3 offset = rest.restOffsets[a] + static_cast<float>(s) * (rest.restOffsets[b] - rest.restOffsets[a]);
+  rest.restOffsets.push_back(offset);
+  st.position.push_back(glm::mix(st.position[a], st.position[b], s));
+  st.previousPosition.push_back(glm::mix(st.previousPosition[a], st.previousPosition[b], s));
+  if (!st.velocity.empty()) st.velocity.push_back(glm::mix(st.velocity[a], st.velocity[b], s));
+  const bool pinned = st.pinned[a] && st.pinned[b];
+  st.mass.push_back(0.0f);
+  st.inverseMass.push_back(pinned ? 0.0 : 1.0);
+  st.pinned.push_back(pinned ? 1 : 0);
+  return p;
+}
+
+// A triangle a cut splits: its corners and neighbours before, and what it became.
+struct Split {
+  std::uint32_t parent;
+  Triangle corners;
+  std::array<std::int32_t, 3> neighbour;
+  struct Child {
+    Triangle corners;
+    std::array<std::int8_t, 3> from;  // per edge: the parent's edge it lies on, or -1 inside the parent
+    std::uint32_t index = 0;
+  };
+  std::vector<Child> children;
+  int cutEdgeChild = -1, cutEdge = -1;  // the child edge the cut runs along, if it runs through
+};
+
+}  // namespace
+
+bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, std::vector<ParticleSplit>& splits,
+         std::vector<ParticleInsert>& inserted) {
   const Real length = glm::length(b - a);
   const Vec3 across = glm::cross(b - a, depth);
   if (!(length > 1e-12) || !(glm::length(across) > 1e-12 * length)) return false;
   const Vec3 along = (b - a) / length;
   const Vec3 normal = glm::normalize(across);
-  const ParticleState& s = cloth.state;
-  const auto left = [&](ParticleIndex p) { return glm::dot(s.position[p] - a, normal) >= 0.0; };
-  const auto within = [&](Vec3 x) {
-    const Real u = glm::dot(x - a, along);
-    return u >= 0.0 && u <= length;
-  };
   build(cloth);
   Topology& topology = cloth.topology;
-  const auto& triangles = cloth.rest.triangles;
-  std::vector<ParticleIndex> touched;
-  bool changed = false;
-  // The crack runs along the edges that bound the crossed triangles on the left: such an edge has
-  // both ends on the left, and of its two triangles one lies wholly on the left, the other is crossed.
-  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+  ClothRest& rest = cloth.rest;
+  ParticleState& s = cloth.state;
+  const std::size_t n0 = rest.particleCount();
+  const std::size_t t0 = rest.triangles.size();
+  // A swipe is cut segment by segment; the segment before this one (when it ended where this one
+  // starts) may have left the cut at a tip inside the triangle this one starts in.
+  std::vector<ParticleIndex> tips;
+  if (topology.cutEnd == a) tips = topology.cutTips;
+  topology.cutTips.clear();
+  topology.cutEnd = b;
+  const auto isTip = [&](ParticleIndex p) { return std::find(tips.begin(), tips.end(), p) != tips.end(); };
+  const auto ahead = [&](Vec3 x) { return glm::dot(x - a, along); };  // m along the swipe from a
+  const auto within = [&](Vec3 x) {
+    const Real u = ahead(x);
+    return u >= 0.0 && u <= length;
+  };
+  const Real onLine = kOnLine * topology.spacing;
+  std::vector<Real> distance(n0);
+  std::vector<std::int8_t> side(n0);
+  for (std::size_t p = 0; p < n0; ++p) {
+    distance[p] = glm::dot(s.position[p] - a, normal);
+    side[p] = std::abs(distance[p]) < onLine ? 0 : distance[p] > 0.0 ? 1 : -1;
+  }
+  // A point of the cut on a particle: one on the line, within the swipe (or where the last segment left off).
+  std::vector<std::uint8_t> onCutFlag(n0, 0);
+  for (std::size_t p = 0; p < n0; ++p) {
+    onCutFlag[p] = side[p] == 0 && (within(s.position[p]) || isTip(static_cast<ParticleIndex>(p)));
+  }
+  const auto onCut = [&](ParticleIndex p) { return p < n0 && onCutFlag[p] != 0; };
+  // The points of the cut near this segment's end are where the next segment of the swipe carries
+  // it on from: tips left by earlier segments, particles on the cut and the new ones.
+  const auto rememberTips = [&] {
+    const auto nearEnd = [&](ParticleIndex p) {
+      return std::abs(ahead(s.position[p]) - length) <= 1.5 * topology.spacing;
+    };
+    for (const ParticleIndex p : tips) {
+      if (p < s.position.size() && nearEnd(p)) topology.cutTips.push_back(p);
+    }
+    for (std::size_t p = 0; p < n0; ++p) {
+      if (onCutFlag[p] && nearEnd(static_cast<ParticleIndex>(p)))
+        topology.cutTips.push_back(static_cast<ParticleIndex>(p));
+    }
+    for (const ParticleInsert& in : inserted) {
+      if (nearEnd(in.particle)) topology.cutTips.push_back(in.particle);
+    }
+    std::sort(topology.cutTips.begin(), topology.cutTips.end());
+    topology.cutTips.erase(std::unique(topology.cutTips.begin(), topology.cutTips.end()), topology.cutTips.end());
+  };
+  // New particles where the plane crosses an edge within the swipe, one per edge.
+  std::vector<std::pair<std::uint64_t, ParticleIndex>> crossing;  // edge key -> its particle
+  const auto key = [](ParticleIndex p, ParticleIndex q) {
+    return static_cast<std::uint64_t>(std::min(p, q)) << 32 | std::max(p, q);
+  };
+  const auto crosses = [&](ParticleIndex p, ParticleIndex q) { return side[p] * side[q] < 0; };
+  const auto crossingAt = [&](ParticleIndex p, ParticleIndex q) { return distance[p] / (distance[p] - distance[q]); };
+  for (std::uint32_t t = 0; t < t0; ++t) {
     for (int k = 0; k < 3; ++k) {
-      const std::int32_t other = topology.neighbour[t][static_cast<std::size_t>(k)];
-      if (other < static_cast<std::int32_t>(t)) continue;  // none, or seen from the other side
-      const Triangle& tri = triangles[t];
-      const Triangle& next = triangles[static_cast<std::size_t>(other)];
-      const ParticleIndex p = tri[k], q = tri[(k + 1) % 3], r = tri[(k + 2) % 3];
-      ParticleIndex rOther = next[0];
-      for (int m = 0; m < 3; ++m) {
-        if (next[m] != p && next[m] != q) rOther = next[m];
-      }
-      if (!left(p) || !left(q) || left(r) == left(rOther)) continue;
-      const Triangle& crossed = left(r) ? next : tri;
-      if (!within((s.position[crossed[0]] + s.position[crossed[1]] + s.position[crossed[2]]) / 3.0)) continue;
-      sever(topology, t, k);
-      touched.push_back(p);
-      touched.push_back(q);
-      changed = true;
+      const ParticleIndex p = rest.triangles[t][k], q = rest.triangles[t][(k + 1) % 3];
+      if (!crosses(p, q)) continue;
+      if (!within(glm::mix(s.position[p], s.position[q], crossingAt(p, q)))) continue;
+      crossing.push_back({key(p, q), 0});
     }
   }
+  std::sort(crossing.begin(), crossing.end());
+  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+  if (crossing.size() > particleBudget) {
+    rememberTips();
+    return false;
+  }
+  const Incidence incidence(rest.triangles, n0);
+  // Particles on the line go onto the plane, along the edge that takes them there soonest.
+  std::vector<ParticleIndex> moved;
+  for (std::size_t p = 0; p < n0; ++p) {
+    if (side[p] != 0 || distance[p] == 0.0 || s.inverseMass[p] == 0.0) continue;
+    if (!onCutFlag[p]) continue;
+    Real best = std::numeric_limits<Real>::infinity(), shortest = best, bestS = 0.0;
+    ParticleIndex to = 0;
+    for (auto t = incidence.begin(static_cast<ParticleIndex>(p)); t != incidence.end(static_cast<ParticleIndex>(p));
+         ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const ParticleIndex q = rest.triangles[*t][k];
+        if (q == p) continue;
+        const Real edge = restEdge(rest, static_cast<ParticleIndex>(p), q);
+        shortest = std::min(shortest, edge);
+        if (side[q] == 0 || (distance[q] > 0.0) == (distance[p] > 0.0)) continue;
+        const Real at = distance[p] / (distance[p] - distance[q]);
+        if (at * edge < best) {
+          best = at * edge;
+          bestS = at;
+          to = q;
+        }
+      }
+    }
+    if (!(best <= 0.4 * shortest)) continue;
+    rest.restOffsets[p] += static_cast<float>(bestS) * (rest.restOffsets[to] - rest.restOffsets[p]);
+    s.position[p] = glm::mix(s.position[p], s.position[to], bestS);
+    s.previousPosition[p] = glm::mix(s.previousPosition[p], s.previousPosition[to], bestS);
+    if (!s.velocity.empty()) s.velocity[p] = glm::mix(s.velocity[p], s.velocity[to], bestS);
+    distance[p] = 0.0;
+    moved.push_back(static_cast<ParticleIndex>(p));
+  }
+  for (auto& [edge, particle] : crossing) {
+    const auto p = static_cast<ParticleIndex>(edge >> 32), q = static_cast<ParticleIndex>(edge & 0xffffffffu);
+    const Real at = crossingAt(p, q);
+    particle = insertParticle(cloth, p, q, at);
+    inserted.push_back({p, q, at, particle});
+  }
+  particleBudget -= crossing.size();
+  const auto pointOn = [&](ParticleIndex p, ParticleIndex q) -> std::int64_t {
+    const auto found = std::lower_bound(crossing.begin(), crossing.end(), std::pair{key(p, q), ParticleIndex{0}});
+    return found != crossing.end() && found->first == key(p, q) ? static_cast<std::int64_t>(found->second) : -1;
+  };
+  // Split every triangle with a new particle on an edge; note the cut's edges.
+  std::vector<Split> split;
+  struct OnEdge {  // an edge of the mesh as it was that lies on the cut: both ends on it
+    std::uint32_t triangle;
+    int edge;
+  };
+  std::vector<OnEdge> onEdge;
+  for (std::uint32_t t = 0; t < t0; ++t) {
+    const Triangle c = rest.triangles[t];
+    std::array<std::int64_t, 3> x{};
+    int count = 0;
+    for (int k = 0; k < 3; ++k) {
+      x[static_cast<std::size_t>(k)] = pointOn(c[k], c[(k + 1) % 3]);
+      if (x[static_cast<std::size_t>(k)] >= 0) ++count;
+    }
+    if (count == 0) {
+      for (int k = 0; k < 3; ++k) {
+        if (onCut(c[k]) && onCut(c[(k + 1) % 3]) && side[c[(k + 2) % 3]] != 0) onEdge.push_back({t, k});
+      }
+      continue;
+    }
+    Split sp;
+    sp.parent = t;
+    sp.corners = c;
+    sp.neighbour = topology.neighbour[t];
+    using F = std::array<std::int8_t, 3>;
+    if (count == 2) {
+      // Edges i and i + 1 cut: corner i + 1 is alone on its side.
+      int i = 0;
+      while (!(x[static_cast<std::size_t>(i)] >= 0 && x[static_cast<std::size_t>((i + 1) % 3)] >= 0)) ++i;
+      const int j = (i + 1) % 3, m = (i + 2) % 3;
+      const auto xi = static_cast<ParticleIndex>(x[static_cast<std::size_t>(i)]);
+      const auto xj = static_cast<ParticleIndex>(x[static_cast<std::size_t>(j)]);
+      const ParticleIndex lone = c[j], next = c[m], first = c[i];
+      sp.children.push_back({Triangle(xi, lone, xj), F{static_cast<std::int8_t>(i), static_cast<std::int8_t>(j), -1}});
+      // The rest, a quad xj next first xi, along whichever diagonal leaves the larger smallest angle.
+      const Real viaFirst = std::min(smallestAngle(rest, xj, next, first), smallestAngle(rest, xj, first, xi));
+      const Real viaNext = std::min(smallestAngle(rest, xj, next, xi), smallestAngle(rest, next, first, xi));
+      if (viaFirst >= viaNext) {
+        sp.children.push_back(
+            {Triangle(xj, next, first), F{static_cast<std::int8_t>(j), static_cast<std::int8_t>(m), -1}});
+        sp.children.push_back({Triangle(xj, first, xi), F{-1, static_cast<std::int8_t>(i), -1}});
+        sp.cutEdgeChild = 2;
+        sp.cutEdge = 2;
+      } else {
+        sp.children.push_back({Triangle(xj, next, xi), F{static_cast<std::int8_t>(j), -1, -1}});
+        sp.children.push_back(
+            {Triangle(next, first, xi), F{static_cast<std::int8_t>(m), static_cast<std::int8_t>(i), -1}});
+        sp.cutEdgeChild = 1;
+        sp.cutEdge = 2;
+      }
+    } else if (count == 1) {
+      int i = 0;
+      while (x[static_cast<std::size_t>(i)] < 0) ++i;
+      const int j = (i + 1) % 3, m = (i + 2) % 3;
+      const auto xi = static_cast<ParticleIndex>(x[static_cast<std::size_t>(i)]);
+      const ParticleIndex opposite = c[m];
+      sp.children.push_back(
+          {Triangle(c[i], xi, opposite), F{static_cast<std::int8_t>(i), -1, static_cast<std::int8_t>(m)}});
+      sp.children.push_back(
+          {Triangle(xi, c[j], opposite), F{static_cast<std::int8_t>(i), static_cast<std::int8_t>(j), -1}});
+      // The cut runs on to the opposite corner where that is on the cut (or where the last segment
+      // left it); else the swipe ends (or starts) inside this triangle, at xi.
+      if (onCut(opposite) || isTip(opposite)) {
+        sp.cutEdgeChild = 0;
+        sp.cutEdge = 1;
+      }
+    } else {
+      continue;  // three: cannot happen (a plane crosses at most two edges of a triangle)
+    }
+    split.push_back(std::move(sp));
+  }
+  // The constraints the split triangles witness, as particle pairs, to be found again in their children.
+  std::vector<std::uint8_t> isParent(t0, 0);
+  for (const Split& sp : split) isParent[sp.parent] = 1;
+  struct Pair {
+    ConstraintKind kind;
+    ParticleIndex a, b;
+    RestReal restLength;
+  };
+  std::vector<Pair> again;
+  for (ConstraintTemplate& x : topology.templates) {
+    if (x.link == ConstraintTemplate::Link::free || (!isParent[x.t1] && !isParent[x.t2])) continue;
+    const Triangle& c1 = rest.triangles[x.t1];
+    const Triangle& c2 = rest.triangles[x.t2];
+    bool alive = true;
+    if (x.link == ConstraintTemplate::Link::across) {
+      alive = topology.neighbour[x.t1][x.middle1] == static_cast<std::int32_t>(x.t2);
+    } else if (x.link == ConstraintTemplate::Link::through) {
+      alive = c1[x.middle1] == c2[x.middle2];
+    }
+    if (alive) again.push_back({x.kind, c1[x.corner1], c2[x.corner2], x.restLength});
+    x.link = ConstraintTemplate::Link::free;  // this recipe is gone; the pair is found again below
+    x.broken = true;
+    x.t1 = x.t2 = 0;
+  }
+  // Each new particle's mass, from the nearer end of its edge: as much as that end holds per unit
+  // of area, times a third of the area of the triangles around the new particle. (One giver a
+  // particle keeps the mass exactly what it was: takeShare.)
+  std::vector<Real> giverArea(inserted.size(), 0.0);
+  for (std::size_t k = 0; k < inserted.size(); ++k) {
+    const ParticleInsert& in = inserted[k];
+    const ParticleIndex giver = in.s < 0.5 ? in.a : in.b;
+    for (auto t = incidence.begin(giver); t != incidence.end(giver); ++t)
+      giverArea[k] += topology.triangleArea[*t] / 3.0;
+  }
+  // Put the children in: the first in the parent's place, the others at the end.
+  for (Split& sp : split) {
+    for (std::size_t k = 0; k < sp.children.size(); ++k) {
+      Split::Child& child = sp.children[k];
+      if (k == 0) {
+        child.index = sp.parent;
+        rest.triangles[sp.parent] = child.corners;
+      } else {
+        child.index = static_cast<std::uint32_t>(rest.triangles.size());
+        rest.triangles.push_back(child.corners);
+      }
+    }
+  }
+  const std::size_t t1 = rest.triangles.size();
+  topology.neighbour.resize(t1, {-1, -1, -1});
+  topology.triangleArea.resize(t1);
+  std::vector<Real> insertedArea(rest.particleCount() - n0, 0.0);
+  for (const Split& sp : split) {
+    for (const Split::Child& child : sp.children) {
+      const Real area = triangleArea(rest, child.corners);
+      topology.triangleArea[child.index] = area;
+      for (int k = 0; k < 3; ++k) {
+        if (child.corners[k] >= n0) insertedArea[child.corners[k] - n0] += area / 3.0;
+      }
+    }
+  }
+  for (std::size_t k = 0; k < inserted.size(); ++k) {
+    const ParticleInsert& in = inserted[k];
+    const ParticleIndex giver = in.s < 0.5 ? in.a : in.b;
+    const Real wanted = giverArea[k] > 0.0
+                            ? static_cast<Real>(s.mass[giver]) * insertedArea[in.particle - n0] / giverArea[k]
+                            : 0.5 * static_cast<Real>(s.mass[giver]);
+    const MassReal share = takeShare(s.mass[giver], wanted > 0.0 ? wanted : 0.5 * static_cast<Real>(s.mass[giver]));
+    s.mass[in.particle] = share;
+    if (s.inverseMass[in.particle] > 0.0) s.inverseMass[in.particle] = 1.0 / share;
+    if (s.inverseMass[giver] > 0.0) s.inverseMass[giver] = 1.0 / s.mass[giver];
+  }
+  // Join the children to each other and to their parents' neighbours, across the edges that were joined.
+  struct Use {
+    std::uint64_t key;
+    std::uint32_t triangle;
+    int edge;
+  };
+  std::vector<Use> uses;
+  for (const Split& sp : split) {
+    for (const Split::Child& child : sp.children) {
+      topology.neighbour[child.index] = {-1, -1, -1};
+      for (int k = 0; k < 3; ++k) {
+        const std::int8_t from = child.from[static_cast<std::size_t>(k)];
+        if (from >= 0 && sp.neighbour[static_cast<std::size_t>(from)] < 0) continue;
+        uses.push_back({key(child.corners[k], child.corners[(k + 1) % 3]), child.index, k});
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t other = sp.neighbour[static_cast<std::size_t>(k)];
+      if (other < 0 || isParent[static_cast<std::size_t>(other)]) continue;
+      // A neighbour left whole: its edge to the parent goes to whichever child has that edge now.
+      auto& back = topology.neighbour[static_cast<std::size_t>(other)];
+      for (int e = 0; e < 3; ++e) {
+        if (back[static_cast<std::size_t>(e)] != static_cast<std::int32_t>(sp.parent)) continue;
+        back[static_cast<std::size_t>(e)] = -1;
+        const Triangle& o = rest.triangles[static_cast<std::size_t>(other)];
+        uses.push_back({key(o[e], o[(e + 1) % 3]), static_cast<std::uint32_t>(other), e});
+      }
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const Use& l, const Use& r) {
+    return std::tie(l.key, l.triangle, l.edge) < std::tie(r.key, r.triangle, r.edge);
+  });
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    if (j - i == 2) {
+      topology.neighbour[uses[i].triangle][static_cast<std::size_t>(uses[i].edge)] =
+          static_cast<std::int32_t>(uses[i + 1].triangle);
+      topology.neighbour[uses[i + 1].triangle][static_cast<std::size_t>(uses[i + 1].edge)] =
+          static_cast<std::int32_t>(uses[i].triangle);
+    }
+    i = j;
+  }
+  // Sever the cut: the children's edge along it, and the old edges with both ends on it that part
+  // triangles on opposite sides.
+  std::vector<ParticleIndex> touched;
+  bool severed = false;
+  for (const Split& sp : split) {
+    if (sp.cutEdgeChild < 0) continue;
+    const Split::Child& child = sp.children[static_cast<std::size_t>(sp.cutEdgeChild)];
+    touched.push_back(child.corners[sp.cutEdge]);
+    touched.push_back(child.corners[(sp.cutEdge + 1) % 3]);
+    sever(topology, child.index, sp.cutEdge);
+    severed = true;
+  }
+  for (const OnEdge& e : onEdge) {
+    const std::int32_t other = topology.neighbour[e.triangle][static_cast<std::size_t>(e.edge)];
+    if (other < 0) continue;
+    const Triangle& t = rest.triangles[e.triangle];
+    const Triangle& o = rest.triangles[static_cast<std::size_t>(other)];
+    const ParticleIndex p = t[e.edge], q = t[(e.edge + 1) % 3];
+    ParticleIndex far = o[0];
+    for (int k = 0; k < 3; ++k) {
+      if (o[k] != p && o[k] != q) far = o[k];
+    }
+    if (side[t[(e.edge + 2) % 3]] * side[far] >= 0) continue;
+    touched.push_back(p);
+    touched.push_back(q);
+    sever(topology, e.triangle, e.edge);
+    severed = true;
+  }
+  // A link no triangle witnesses (a chain) breaks where the cut crosses it.
   for (ConstraintTemplate& x : topology.templates) {
     if (x.link != ConstraintTemplate::Link::free || x.broken) continue;
     const Vec3 xa = s.position[x.t1], xb = s.position[x.t2];
     const Real da = glm::dot(xa - a, normal), db = glm::dot(xb - a, normal);
-    if ((da >= 0.0) == (db >= 0.0)) continue;
-    if (!within(xa + (xb - xa) * (da / (da - db)))) continue;
+    if ((da >= 0.0) == (db >= 0.0) || !within(xa + (xb - xa) * (da / (da - db)))) continue;
     x.broken = true;
     ++topology.torn;
-    changed = true;
+    severed = true;
   }
-  if (!changed) return false;
+  rememberTips();
+  if (split.empty() && !severed && moved.empty()) return false;
+  // The constraints again, over the children, and one along every new edge.
+  const Incidence after(rest.triangles, rest.particleCount());
+  for (const Pair& pair : again) {
+    addTemplates(topology, rest, after, pair.kind, {pair.a, pair.b, pair.restLength}, false);
+  }
+  for (const Split& sp : split) {
+    for (const Split::Child& child : sp.children) {
+      for (int k = 0; k < 3; ++k) {
+        const ParticleIndex p = child.corners[k], q = child.corners[(k + 1) % 3];
+        if (p < n0 && q < n0) continue;
+        const Real edge = restEdge(rest, p, q);
+        if (!(edge > 0.0)) continue;
+        ConstraintTemplate x;
+        x.kind = ConstraintKind::stretch;
+        x.restLength = toRestLength(edge);
+        x.link = ConstraintTemplate::Link::same;
+        x.t1 = x.t2 = child.index;
+        x.corner1 = static_cast<std::uint8_t>(k);
+        x.corner2 = static_cast<std::uint8_t>((k + 1) % 3);
+        topology.templates.push_back(x);
+      }
+    }
+  }
   splitParticles(cloth, std::move(touched), particleBudget, splits);
   rebuildConstraints(cloth);
+  // A particle moved onto the cut (and its copies) is at a new rest distance from its neighbours.
+  std::vector<std::uint8_t> shifted(rest.particleCount(), 0);
+  for (const ParticleIndex p : moved) shifted[p] = 1;
+  for (const ParticleSplit& made : splits) {
+    if (made.original < shifted.size() && shifted[made.original]) shifted[made.copy] = 1;
+  }
+  if (!moved.empty()) {
+    for (std::size_t k = 0; k < kConstraintKindCount; ++k) {
+      for (std::size_t j = 0; j < rest.constraints[k].size(); ++j) {
+        DistanceConstraint& c = rest.constraints[k][j];
+        if (!shifted[c.a] && !shifted[c.b]) continue;
+        const Real edge = restEdge(rest, c.a, c.b);
+        if (!(edge > 0.0)) continue;
+        c.restLength = toRestLength(edge);
+        topology.templates[topology.source[k][j]].restLength = c.restLength;
+      }
+    }
+  }
   return true;
 }
 

@@ -19,10 +19,14 @@ void build(Cloth& cloth);
 // At most `particleBudget` particles are made. Returns whether the mesh changed.
 bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<ParticleSplit>& splits);
 
-// Cuts along the surface swept by the segment a-b moved along `depth` (both ways, without end): every
-// triangle it crosses is parted from the triangles on one side (the side cross(b - a, depth) points
-// to), so the cloth opens along the cut. Returns whether the mesh changed.
-bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, std::vector<ParticleSplit>& splits);
+// Cuts along the surface swept by the segment a-b moved along `depth` (both ways, without end), through
+// the triangles: a particle within a fifth of the spacing of that surface is moved onto it (along an
+// edge), every edge it crosses gets a new particle there (`inserted`), each crossed triangle is split
+// in two or three along the cut, and the mesh is opened along it. A segment that ends inside a
+// triangle leaves a tip there that the next segment of the same swipe (starting where this one
+// ended) carries on from. Mass is conserved exactly. Returns whether the mesh changed.
+bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, std::vector<ParticleSplit>& splits,
+         std::vector<ParticleInsert>& inserted);
 
 // Connected pieces: per particle, the number of its piece (0, 1, ... in order of the lowest
 // particle), joined through triangles and constraints; empty if there is one piece (Cloth::piece).

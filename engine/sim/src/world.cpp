@@ -879,10 +879,29 @@ std::size_t World::particleCount() const {
   return n;
 }
 
-void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>& splits) {
+void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>& splits,
+                                const std::vector<ParticleInsert>& inserted) {
   Cloth& cloth = cloths_[c];
   const std::size_t n = cloth.state.position.size();
   if (!held_[c].empty()) held_[c].resize(n, 0);
+  // A particle a cut put between two particles one finger holds is held by it too, where it lies.
+  for (const ParticleInsert& in : inserted) {
+    if (!isHeld(c, in.a) || !isHeld(c, in.b)) continue;
+    for (Finger& f : fingers_) {
+      const FingerGrip *ga = nullptr, *gb = nullptr;
+      for (const FingerGrip& g : f.grips) {
+        if (g.cloth != static_cast<int>(c)) continue;
+        if (g.particle == in.a) ga = &g;
+        if (g.particle == in.b) gb = &g;
+      }
+      if (!ga || !gb) continue;
+      const Vec3 offset = glm::mix(ga->offset, gb->offset, in.s);
+      f.grips.push_back({static_cast<int>(c), in.particle, offset});
+      held_[c][in.particle] = 1;
+      cloth.state.inverseMass[in.particle] = 0.0;
+      break;
+    }
+  }
   // A copy of a held particle stays in the same finger's grip.
   for (const ParticleSplit& split : splits) {
     if (!isHeld(c, split.original)) continue;
@@ -925,12 +944,14 @@ int World::cut(Vec3 a, Vec3 b, Vec3 depth) {
   if (!finite(a) || !finite(b) || !finite(depth)) return 0;
   int opened = 0;
   std::vector<ParticleSplit> splits;
+  std::vector<ParticleInsert> inserted;
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     splits.clear();
+    inserted.clear();
     const std::size_t budget =
         static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
-    if (!topology::cut(cloths_[c], a, b, depth, budget, splits)) continue;
-    afterTopologyChange(c, splits);
+    if (!topology::cut(cloths_[c], a, b, depth, budget, splits, inserted)) continue;
+    afterTopologyChange(c, splits, inserted);
     ++opened;
   }
   return opened;

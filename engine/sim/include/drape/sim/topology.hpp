@@ -1,6 +1,7 @@
 // What a cloth needs to know about its own connectivity once its mesh can change (tearing, cutting).
 //
-// Tearing and cutting never delete material: they split particles. The triangles are the truth:
+// Tearing and cutting never delete material: they split particles (and a cut first splits the
+// triangles it crosses, with new particles on their edges: topology::cut). The triangles are the truth:
 // two triangles that share an edge are joined across it until that edge is severed, and every
 // particle is one fan of triangles around a point. Severing edges and then splitting each particle
 // whose fan fell apart into one particle per remaining fan opens the mesh for real, so no triangle
@@ -45,6 +46,14 @@ struct ParticleSplit {
   ParticleIndex copy;
 };
 
+// A particle a cut put on the edge a-b where the cut crossed it: at a + s (b - a), at rest and now.
+struct ParticleInsert {
+  ParticleIndex a;
+  ParticleIndex b;
+  Real s;
+  ParticleIndex particle;
+};
+
 struct Topology {
   bool built = false;
   // Per triangle, the triangle joined to it across edge k (corners k and k+1 mod 3), or -1.
@@ -54,6 +63,11 @@ struct Topology {
   std::size_t torn = 0;  // edges severed and links broken so far (tearing and cutting)
   // Per current constraint, by kind: the template it came from.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> source;
+  Real spacing = 0.0;  // m, the median stretch rest length when built: the scale cuts snap at
+  // Where the last cut segment ended inside a triangle: the particles it left on that triangle's
+  // edge, which the next segment of the same swipe (starting at `cutEnd`) carries the cut on from.
+  std::vector<ParticleIndex> cutTips;
+  Vec3 cutEnd{0.0};
 };
 
 }  // namespace drape::sim

@@ -209,7 +209,8 @@ class World {
   // or tune): it reorders the cloth's constraints (bend and shear into batches, stretch into line
   // order, lines::build), so their order in cloths() changes at the first step and after a tear.
   void plan(std::size_t cloth);
-  void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits);
+  void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits,
+                           const std::vector<ParticleInsert>& inserted = {});
   void moveFingers(Real h);
   void tear();
   void grab(Finger& finger, std::size_t cloth, ParticleIndex nearest);
