@@ -98,8 +98,10 @@ fs::path outputDirectory() {
 }
 
 int render(const std::string& arguments, const fs::path& out) {
-  // Built by appending: GCC 12 at -O3 warns falsely (-Wrestrict) on a chain of + here.
-  std::string command = "'";
+  // Built by appending: GCC 12 at -O3 warns falsely (-Wrestrict) on a chain of + here. Run from the
+  // source tree, as tools/golden runs, so a case's paths (assets/gestures/...) are found.
+  std::string command = "cd '";
+  command.append(fs::path(DRAPE_ASSET_DIR).parent_path().string()).append("' && '");
   command.append(DRAPE_CLI)
       .append("' render ")
       .append(arguments)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <tuple>
@@ -39,10 +40,6 @@ struct Incidence {
   const std::uint32_t* begin(ParticleIndex v) const { return list.data() + start[v]; }
   const std::uint32_t* end(ParticleIndex v) const { return list.data() + start[v + 1]; }
 };
-
-Vec3 restCentroid(const ClothRest& rest, const Triangle& t) {
-  return (rest.restPosition(t[0]) + rest.restPosition(t[1]) + rest.restPosition(t[2])) / 3.0;
-}
 
 // The recipes that make constraint c from the triangles. With allowFree, a pair no triangle
 // witnesses gets a free link; without, none.
@@ -270,6 +267,23 @@ void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_
   }
 }
 
+// Every constraint's recipes, from the constraints and triangles as they are now: as a world
+// loaded from a snapshot of this one would make them, so the two run on alike.
+void makeTemplates(Cloth& cloth) {
+  Topology& topology = cloth.topology;
+  const ClothRest& rest = cloth.rest;
+  const Incidence incidence(rest.triangles, rest.particleCount());
+  topology.templates.clear();
+  for (ConstraintKind kind : kConstraintKinds) {
+    auto& source = topology.source[static_cast<std::size_t>(kind)];
+    source.clear();
+    for (const DistanceConstraint& c : rest.of(kind)) {
+      source.push_back(static_cast<std::uint32_t>(topology.templates.size()));
+      addTemplates(topology, rest, incidence, kind, c);
+    }
+  }
+}
+
 }  // namespace
 
 void build(Cloth& cloth) {
@@ -310,106 +324,30 @@ void build(Cloth& cloth) {
     }
     i = j;
   }
-  const Incidence incidence(triangles, rest.particleCount());
-  topology.templates.clear();
-  for (ConstraintKind kind : kConstraintKinds) {
-    auto& source = topology.source[static_cast<std::size_t>(kind)];
-    source.clear();
-    for (const DistanceConstraint& c : rest.of(kind)) {
-      source.push_back(static_cast<std::uint32_t>(topology.templates.size()));
-      addTemplates(topology, rest, incidence, kind, c);
+  makeTemplates(cloth);
+  // The scale a cut snaps at: the spacing the cloth was made with (so a snapshot, which keeps the
+  // settings, snaps as the world it was taken from); else the median stretch rest length.
+  const ClothSettings& settings = cloth.settings;
+  topology.spacing = 0.0;
+  if (settings.outline) {
+    topology.spacing = settings.outline->spacing;
+  } else {
+    const LatticeSpec& l = settings.lattice;
+    Real spacing = std::numeric_limits<Real>::infinity();
+    if (l.columns > 1) spacing = std::min(spacing, l.width / (l.columns - 1));
+    if (l.rows > 1) spacing = std::min(spacing, l.height / (l.rows - 1));
+    if (std::isfinite(spacing) && spacing > 0.0) topology.spacing = spacing;
+  }
+  if (!(topology.spacing > 0.0)) {
+    std::vector<Real> lengths;
+    for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) lengths.push_back(c.restLength);
+    if (!lengths.empty()) {
+      std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2),
+                       lengths.end());
+      topology.spacing = lengths[lengths.size() / 2];
     }
-  }
-  // The scale a cut snaps at: the median stretch rest length (or of any constraint, or of the edges).
-  std::vector<Real> lengths;
-  for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) lengths.push_back(c.restLength);
-  for (std::size_t k = 0; lengths.empty() && k < kConstraintKindCount; ++k) {
-    for (const DistanceConstraint& c : rest.constraints[k]) lengths.push_back(c.restLength);
-  }
-  for (std::size_t t = 0; lengths.empty() && t < triangles.size(); ++t) {
-    lengths.push_back(glm::length(rest.restPosition(triangles[t][1]) - rest.restPosition(triangles[t][0])));
-  }
-  if (!lengths.empty()) {
-    std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2), lengths.end());
-    topology.spacing = lengths[lengths.size() / 2];
   }
   topology.built = true;
-}
-
-bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<ParticleSplit>& splits) {
-  const ParticleState& s = cloth.state;
-  const auto& stretch = cloth.rest.of(ConstraintKind::stretch);
-  std::vector<std::pair<Real, std::uint32_t>> strained;
-  for (std::uint32_t j = 0; j < stretch.size(); ++j) {
-    const DistanceConstraint& c = stretch[j];
-    const Real length = glm::length(s.position[c.b] - s.position[c.a]);
-    if (length > threshold * c.restLength) strained.push_back({length / c.restLength, j});
-  }
-  if (strained.empty()) return false;
-  build(cloth);
-  // The most strained first: they decide where the crack runs.
-  std::sort(strained.begin(), strained.end(), [](const auto& l, const auto& r) {
-    return l.first > r.first || (l.first == r.first && l.second < r.second);
-  });
-  Topology& topology = cloth.topology;
-  const ClothRest& rest = cloth.rest;
-  const Incidence incidence(rest.triangles, rest.particleCount());
-  std::vector<ParticleIndex> touched;
-  bool changed = false;
-  // Severs the joined edges at v that separate triangles ahead of v along `pull` from those behind.
-  const auto severAround = [&](ParticleIndex v, Vec3 pull) {
-    bool severed = false;
-    const auto ahead = [&](std::uint32_t t) {
-      return glm::dot(restCentroid(rest, rest.triangles[t]) - rest.restPosition(v), pull) > 0.0;
-    };
-    for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
-      const int cv = cornerOf(rest.triangles[*t], v);
-      for (const int edge : {cv, (cv + 2) % 3}) {
-        const std::int32_t other = topology.neighbour[*t][static_cast<std::size_t>(edge)];
-        if (other < 0 || ahead(*t) == ahead(static_cast<std::uint32_t>(other))) continue;
-        sever(topology, *t, edge);
-        touched.push_back(rest.triangles[*t][edge]);
-        touched.push_back(rest.triangles[*t][(edge + 1) % 3]);
-        severed = true;
-      }
-    }
-    return severed;
-  };
-  // One crack step per neighbourhood and pass: a constraint next to particles this pass already
-  // severed around waits for the next pass (and its own strain then), so neighbouring cracks do not
-  // cut out slivers and islands between them.
-  std::vector<std::uint8_t> near(rest.particleCount(), 0);
-  // A free link (no triangle: a chain) breaks alone in its piece: the most strained one, which lets
-  // the rest go. Where links are strained alike (a chain pulled evenly), which of them crosses the
-  // threshold first is rounding, and breaking them all would shatter the chain.
-  std::vector<std::uint32_t> letGo;  // pieces a free link of has broken this pass
-  for (const auto& [ratio, j] : strained) {
-    ConstraintTemplate& x = topology.templates[topology.source[static_cast<std::size_t>(ConstraintKind::stretch)][j]];
-    if (x.link == ConstraintTemplate::Link::free) {
-      const std::uint32_t piece = stretch[j].a < cloth.piece.size() ? cloth.piece[stretch[j].a] : 0;
-      if (std::find(letGo.begin(), letGo.end(), piece) != letGo.end()) continue;
-      letGo.push_back(piece);
-      x.broken = true;
-      ++topology.torn;
-      changed = true;
-      continue;
-    }
-    const DistanceConstraint& c = stretch[j];
-    if (near[c.a] || near[c.b]) continue;
-    const std::size_t before = touched.size();
-    const Vec3 pull = rest.restPosition(c.b) - rest.restPosition(c.a);
-    if (severAround(c.a, pull) || severAround(c.b, -pull)) changed = true;
-    // Mark the triangles around every particle on the new crack.
-    for (std::size_t k = before; k < touched.size(); ++k) {
-      for (auto t = incidence.begin(touched[k]); t != incidence.end(touched[k]); ++t) {
-        for (int corner = 0; corner < 3; ++corner) near[rest.triangles[*t][corner]] = 1;
-      }
-    }
-  }
-  if (!changed) return false;
-  splitParticles(cloth, std::move(touched), particleBudget, splits);
-  rebuildConstraints(cloth);
-  return true;
 }
 
 namespace {
@@ -469,92 +407,62 @@ struct Split {
   int cutEdgeChild = -1, cutEdge = -1;  // the child edge the cut runs along, if it runs through
 };
 
-}  // namespace
+// One opening of the mesh along a line: the plane it lies in (as each particle's signed distance
+// from it, m) and which of the particles and edge crossings are part of it.
+struct Line {
+  std::vector<Real> distance;       // per particle
+  std::vector<std::int8_t> side;    // per particle: -1, 1, or 0 within kOnLine spacings of the plane
+  std::vector<std::uint8_t> onCut;  // per particle: on the line and part of the opening
+  std::vector<std::uint8_t> joins;  // per particle: an opening reaching its triangle runs on to it (a swipe's tips)
+  std::function<bool(ParticleIndex, ParticleIndex, Real)> counts;  // whether edge p-q's crossing at p + s (q - p) is
+};
 
-bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, std::vector<ParticleSplit>& splits,
-         std::vector<ParticleInsert>& inserted) {
-  const Real length = glm::length(b - a);
-  const Vec3 across = glm::cross(b - a, depth);
-  if (!(length > 1e-12) || !(glm::length(across) > 1e-12 * length)) return false;
-  const Vec3 along = (b - a) / length;
-  const Vec3 normal = glm::normalize(across);
-  build(cloth);
+// What openings have done that the constraints and particles must follow (finishOpening).
+struct Opening {
+  std::vector<ParticleIndex> touched;  // ends of severed edges
+  std::vector<ParticleIndex> moved;    // particles moved onto a line
+  bool changed = false;
+};
+
+// Splits the triangles the line crosses (those of `consider`, or all) and severs the mesh along it.
+// New particles are appended to `inserted`.
+void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consider, std::size_t& particleBudget,
+               std::vector<ParticleInsert>& inserted, Opening& opening) {
   Topology& topology = cloth.topology;
   ClothRest& rest = cloth.rest;
   ParticleState& s = cloth.state;
   const std::size_t n0 = rest.particleCount();
   const std::size_t t0 = rest.triangles.size();
-  // A swipe is cut segment by segment; the segment before this one (when it ended where this one
-  // starts) may have left the cut at a tip inside the triangle this one starts in.
-  std::vector<ParticleIndex> tips;
-  if (topology.cutEnd == a) tips = topology.cutTips;
-  topology.cutTips.clear();
-  topology.cutEnd = b;
-  const auto isTip = [&](ParticleIndex p) { return std::find(tips.begin(), tips.end(), p) != tips.end(); };
-  const auto ahead = [&](Vec3 x) { return glm::dot(x - a, along); };  // m along the swipe from a
-  const auto within = [&](Vec3 x) {
-    const Real u = ahead(x);
-    return u >= 0.0 && u <= length;
-  };
-  const Real onLine = kOnLine * topology.spacing;
-  std::vector<Real> distance(n0);
-  std::vector<std::int8_t> side(n0);
-  for (std::size_t p = 0; p < n0; ++p) {
-    distance[p] = glm::dot(s.position[p] - a, normal);
-    side[p] = std::abs(distance[p]) < onLine ? 0 : distance[p] > 0.0 ? 1 : -1;
-  }
-  // A point of the cut on a particle: one on the line, within the swipe (or where the last segment left off).
-  std::vector<std::uint8_t> onCutFlag(n0, 0);
-  for (std::size_t p = 0; p < n0; ++p) {
-    onCutFlag[p] = side[p] == 0 && (within(s.position[p]) || isTip(static_cast<ParticleIndex>(p)));
-  }
-  const auto onCut = [&](ParticleIndex p) { return p < n0 && onCutFlag[p] != 0; };
-  // The points of the cut near this segment's end are where the next segment of the swipe carries
-  // it on from: tips left by earlier segments, particles on the cut and the new ones.
-  const auto rememberTips = [&] {
-    const auto nearEnd = [&](ParticleIndex p) {
-      return std::abs(ahead(s.position[p]) - length) <= 1.5 * topology.spacing;
-    };
-    for (const ParticleIndex p : tips) {
-      if (p < s.position.size() && nearEnd(p)) topology.cutTips.push_back(p);
-    }
-    for (std::size_t p = 0; p < n0; ++p) {
-      if (onCutFlag[p] && nearEnd(static_cast<ParticleIndex>(p)))
-        topology.cutTips.push_back(static_cast<ParticleIndex>(p));
-    }
-    for (const ParticleInsert& in : inserted) {
-      if (nearEnd(in.particle)) topology.cutTips.push_back(in.particle);
-    }
-    std::sort(topology.cutTips.begin(), topology.cutTips.end());
-    topology.cutTips.erase(std::unique(topology.cutTips.begin(), topology.cutTips.end()), topology.cutTips.end());
-  };
-  // New particles where the plane crosses an edge within the swipe, one per edge.
-  std::vector<std::pair<std::uint64_t, ParticleIndex>> crossing;  // edge key -> its particle
+  const std::size_t insertedBefore = inserted.size();
+  std::vector<Real>& distance = line.distance;
+  const std::vector<std::int8_t>& side = line.side;
+  const auto onCut = [&](ParticleIndex p) { return p < n0 && line.onCut[p] != 0; };
   const auto key = [](ParticleIndex p, ParticleIndex q) {
     return static_cast<std::uint64_t>(std::min(p, q)) << 32 | std::max(p, q);
   };
   const auto crosses = [&](ParticleIndex p, ParticleIndex q) { return side[p] * side[q] < 0; };
   const auto crossingAt = [&](ParticleIndex p, ParticleIndex q) { return distance[p] / (distance[p] - distance[q]); };
-  for (std::uint32_t t = 0; t < t0; ++t) {
+  // New particles where the plane crosses an edge, one per edge.
+  std::vector<std::pair<std::uint64_t, ParticleIndex>> crossing;  // edge key -> its particle
+  const auto look = [&](std::uint32_t t) {
     for (int k = 0; k < 3; ++k) {
       const ParticleIndex p = rest.triangles[t][k], q = rest.triangles[t][(k + 1) % 3];
-      if (!crosses(p, q)) continue;
-      if (!within(glm::mix(s.position[p], s.position[q], crossingAt(p, q)))) continue;
-      crossing.push_back({key(p, q), 0});
+      if (crosses(p, q) && line.counts(p, q, crossingAt(p, q))) crossing.push_back({key(p, q), 0});
     }
+  };
+  if (consider) {
+    for (const std::uint32_t t : *consider) look(t);
+  } else {
+    for (std::uint32_t t = 0; t < t0; ++t) look(t);
   }
   std::sort(crossing.begin(), crossing.end());
   crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
-  if (crossing.size() > particleBudget) {
-    rememberTips();
-    return false;
-  }
+  if (crossing.size() > particleBudget) return;
   const Incidence incidence(rest.triangles, n0);
   // Particles on the line go onto the plane, along the edge that takes them there soonest.
-  std::vector<ParticleIndex> moved;
   for (std::size_t p = 0; p < n0; ++p) {
     if (side[p] != 0 || distance[p] == 0.0 || s.inverseMass[p] == 0.0) continue;
-    if (!onCutFlag[p]) continue;
+    if (!line.onCut[p]) continue;
     Real best = std::numeric_limits<Real>::infinity(), shortest = best, bestS = 0.0;
     ParticleIndex to = 0;
     for (auto t = incidence.begin(static_cast<ParticleIndex>(p)); t != incidence.end(static_cast<ParticleIndex>(p));
@@ -564,7 +472,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
         if (q == p) continue;
         const Real edge = restEdge(rest, static_cast<ParticleIndex>(p), q);
         shortest = std::min(shortest, edge);
-        if (side[q] == 0 || (distance[q] > 0.0) == (distance[p] > 0.0)) continue;
+        if (side[q] == 0 || !std::isfinite(distance[q]) || (distance[q] > 0.0) == (distance[p] > 0.0)) continue;
         const Real at = distance[p] / (distance[p] - distance[q]);
         if (at * edge < best) {
           best = at * edge;
@@ -579,7 +487,11 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
     s.previousPosition[p] = glm::mix(s.previousPosition[p], s.previousPosition[to], bestS);
     if (!s.velocity.empty()) s.velocity[p] = glm::mix(s.velocity[p], s.velocity[to], bestS);
     distance[p] = 0.0;
-    moved.push_back(static_cast<ParticleIndex>(p));
+    opening.moved.push_back(static_cast<ParticleIndex>(p));
+    // Its triangles' rest areas follow (they share masses out when particles split).
+    for (auto t = incidence.begin(static_cast<ParticleIndex>(p)); t != incidence.end(static_cast<ParticleIndex>(p));
+         ++t)
+      topology.triangleArea[*t] = triangleArea(rest, rest.triangles[*t]);
   }
   for (auto& [edge, particle] : crossing) {
     const auto p = static_cast<ParticleIndex>(edge >> 32), q = static_cast<ParticleIndex>(edge & 0xffffffffu);
@@ -655,7 +567,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
           {Triangle(xi, c[j], opposite), F{static_cast<std::int8_t>(i), static_cast<std::int8_t>(j), -1}});
       // The cut runs on to the opposite corner where that is on the cut (or where the last segment
       // left it); else the swipe ends (or starts) inside this triangle, at xi.
-      if (onCut(opposite) || isTip(opposite)) {
+      if (onCut(opposite) || (opposite < n0 && line.joins[opposite])) {
         sp.cutEdgeChild = 0;
         sp.cutEdge = 1;
       }
@@ -692,7 +604,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
   // of area, times a third of the area of the triangles around the new particle. (One giver a
   // particle keeps the mass exactly what it was: takeShare.)
   std::vector<Real> giverArea(inserted.size(), 0.0);
-  for (std::size_t k = 0; k < inserted.size(); ++k) {
+  for (std::size_t k = insertedBefore; k < inserted.size(); ++k) {
     const ParticleInsert& in = inserted[k];
     const ParticleIndex giver = in.s < 0.5 ? in.a : in.b;
     for (auto t = incidence.begin(giver); t != incidence.end(giver); ++t)
@@ -724,7 +636,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
       }
     }
   }
-  for (std::size_t k = 0; k < inserted.size(); ++k) {
+  for (std::size_t k = insertedBefore; k < inserted.size(); ++k) {
     const ParticleInsert& in = inserted[k];
     const ParticleIndex giver = in.s < 0.5 ? in.a : in.b;
     const Real wanted = giverArea[k] > 0.0
@@ -780,15 +692,13 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
   }
   // Sever the cut: the children's edge along it, and the old edges with both ends on it that part
   // triangles on opposite sides.
-  std::vector<ParticleIndex> touched;
-  bool severed = false;
   for (const Split& sp : split) {
     if (sp.cutEdgeChild < 0) continue;
     const Split::Child& child = sp.children[static_cast<std::size_t>(sp.cutEdgeChild)];
-    touched.push_back(child.corners[sp.cutEdge]);
-    touched.push_back(child.corners[(sp.cutEdge + 1) % 3]);
+    opening.touched.push_back(child.corners[sp.cutEdge]);
+    opening.touched.push_back(child.corners[(sp.cutEdge + 1) % 3]);
     sever(topology, child.index, sp.cutEdge);
-    severed = true;
+    opening.changed = true;
   }
   for (const OnEdge& e : onEdge) {
     const std::int32_t other = topology.neighbour[e.triangle][static_cast<std::size_t>(e.edge)];
@@ -801,23 +711,12 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
       if (o[k] != p && o[k] != q) far = o[k];
     }
     if (side[t[(e.edge + 2) % 3]] * side[far] >= 0) continue;
-    touched.push_back(p);
-    touched.push_back(q);
+    opening.touched.push_back(p);
+    opening.touched.push_back(q);
     sever(topology, e.triangle, e.edge);
-    severed = true;
+    opening.changed = true;
   }
-  // A link no triangle witnesses (a chain) breaks where the cut crosses it.
-  for (ConstraintTemplate& x : topology.templates) {
-    if (x.link != ConstraintTemplate::Link::free || x.broken) continue;
-    const Vec3 xa = s.position[x.t1], xb = s.position[x.t2];
-    const Real da = glm::dot(xa - a, normal), db = glm::dot(xb - a, normal);
-    if ((da >= 0.0) == (db >= 0.0) || !within(xa + (xb - xa) * (da / (da - db)))) continue;
-    x.broken = true;
-    ++topology.torn;
-    severed = true;
-  }
-  rememberTips();
-  if (split.empty() && !severed && moved.empty()) return false;
+  if (!split.empty() || !opening.moved.empty()) opening.changed = true;
   // The constraints again, over the children, and one along every new edge.
   const Incidence after(rest.triangles, rest.particleCount());
   for (const Pair& pair : again) {
@@ -841,7 +740,15 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
       }
     }
   }
-  splitParticles(cloth, std::move(touched), particleBudget, splits);
+}
+
+// After openings: every particle whose fan fell apart splits, the constraints are made again, and
+// those of particles moved onto a line take their new rest lengths.
+void finishOpening(Cloth& cloth, Opening& opening, std::size_t particleBudget, std::vector<ParticleSplit>& splits) {
+  ClothRest& rest = cloth.rest;
+  Topology& topology = cloth.topology;
+  const std::vector<ParticleIndex>& moved = opening.moved;
+  splitParticles(cloth, std::move(opening.touched), particleBudget, splits);
   rebuildConstraints(cloth);
   // A particle moved onto the cut (and its copies) is at a new rest distance from its neighbours.
   std::vector<std::uint8_t> shifted(rest.particleCount(), 0);
@@ -861,7 +768,430 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
       }
     }
   }
+  // Recipes afresh: those found again in split triangles may name other witnesses than a fresh
+  // search (a snapshot loaded) finds.
+  makeTemplates(cloth);
+}
+
+}  // namespace
+
+bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, std::vector<ParticleSplit>& splits,
+         std::vector<ParticleInsert>& inserted) {
+  const Real length = glm::length(b - a);
+  const Vec3 across = glm::cross(b - a, depth);
+  if (!(length > 1e-12) || !(glm::length(across) > 1e-12 * length)) return false;
+  const Vec3 along = (b - a) / length;
+  const Vec3 normal = glm::normalize(across);
+  build(cloth);
+  Topology& topology = cloth.topology;
+  const ParticleState& s = cloth.state;
+  const std::size_t n0 = cloth.rest.particleCount();
+  // A swipe is cut segment by segment; the segment before this one (when it ended where this one
+  // starts) may have left the cut at tips inside the triangle this one starts in.
+  std::vector<ParticleIndex> tips;
+  if (topology.cutEnd == a) tips = topology.cutTips;
+  topology.cutTips.clear();
+  topology.cutEnd = b;
+  const auto ahead = [&](Vec3 x) { return glm::dot(x - a, along); };  // m along the swipe from a
+  const auto within = [&](Vec3 x) {
+    const Real u = ahead(x);
+    return u >= 0.0 && u <= length;
+  };
+  const Real onLine = kOnLine * topology.spacing;
+  Line line;
+  line.distance.resize(n0);
+  line.side.resize(n0);
+  line.onCut.assign(n0, 0);
+  line.joins.assign(n0, 0);
+  for (const ParticleIndex p : tips) {
+    if (p < n0) line.joins[p] = 1;
+  }
+  for (std::size_t p = 0; p < n0; ++p) {
+    const Real d = glm::dot(s.position[p] - a, normal);
+    line.distance[p] = d;
+    line.side[p] = std::abs(d) < onLine ? 0 : d > 0.0 ? 1 : -1;
+    // A point of the cut on a particle: one on the line, within the swipe (or where the last segment left off).
+    line.onCut[p] = line.side[p] == 0 && (within(s.position[p]) || line.joins[p]);
+  }
+  line.counts = [&](ParticleIndex p, ParticleIndex q, Real at) {
+    return within(glm::mix(s.position[p], s.position[q], at));
+  };
+  const std::vector<std::uint8_t> onCut = line.onCut;
+  Opening opening;
+  openAlong(cloth, line, nullptr, particleBudget, inserted, opening);
+  // A link no triangle witnesses (a chain) breaks where the cut crosses it.
+  for (ConstraintTemplate& x : topology.templates) {
+    if (x.link != ConstraintTemplate::Link::free || x.broken) continue;
+    const Vec3 xa = s.position[x.t1], xb = s.position[x.t2];
+    const Real da = glm::dot(xa - a, normal), db = glm::dot(xb - a, normal);
+    if ((da >= 0.0) == (db >= 0.0) || !within(xa + (xb - xa) * (da / (da - db)))) continue;
+    x.broken = true;
+    ++topology.torn;
+    opening.changed = true;
+  }
+  // The points of the cut near this segment's end are where the next segment of the swipe carries
+  // it on from: tips left by earlier segments, particles on the cut and the new ones.
+  const auto nearEnd = [&](ParticleIndex p) {
+    return std::abs(ahead(s.position[p]) - length) <= 1.5 * topology.spacing;
+  };
+  for (const ParticleIndex p : tips) {
+    if (p < s.position.size() && nearEnd(p)) topology.cutTips.push_back(p);
+  }
+  for (std::size_t p = 0; p < n0; ++p) {
+    if (onCut[p] && nearEnd(static_cast<ParticleIndex>(p))) topology.cutTips.push_back(static_cast<ParticleIndex>(p));
+  }
+  for (const ParticleInsert& in : inserted) {
+    if (nearEnd(in.particle)) topology.cutTips.push_back(in.particle);
+  }
+  std::sort(topology.cutTips.begin(), topology.cutTips.end());
+  topology.cutTips.erase(std::unique(topology.cutTips.begin(), topology.cutTips.end()), topology.cutTips.end());
+  if (!opening.changed) return false;
+  finishOpening(cloth, opening, particleBudget, splits);
   return true;
+}
+
+namespace {
+
+// How a triangle is stretched: C = F^T F of its deformation gradient F (rest to now), as a
+// symmetric 3 x 3 tensor in rest space (xx, yy, zz, xy, xz, yz), and its largest principal stretch.
+struct Stretch {
+  std::array<Real, 6> tensor{};
+  Real largest = 0.0;
+};
+
+Stretch triangleStretch(const Cloth& cloth, const Triangle& t) {
+  const ClothRest& rest = cloth.rest;
+  const std::vector<Vec3>& x = cloth.state.position;
+  const Vec3 e1 = rest.restPosition(t[1]) - rest.restPosition(t[0]);
+  const Vec3 e2 = rest.restPosition(t[2]) - rest.restPosition(t[0]);
+  const Real l1 = glm::length(e1);
+  const Vec3 n = glm::cross(e1, e2);
+  if (!(l1 > 0.0) || !(glm::length(n) > 0.0)) return {};
+  const Vec3 u = e1 / l1, w = glm::normalize(glm::cross(n, u));
+  const Real a = l1, b = glm::dot(u, e2), d = glm::dot(w, e2);  // Dm = [[a, b], [0, d]]
+  const Vec3 s1 = x[t[1]] - x[t[0]], s2 = x[t[2]] - x[t[0]];
+  // F = Ds Dm^-1: its columns, the images of u and w.
+  const Vec3 fu = s1 / a, fw = (s2 - b * fu) / d;
+  const Real cuu = glm::dot(fu, fu), cww = glm::dot(fw, fw), cuw = glm::dot(fu, fw);
+  Stretch out;
+  const Real half = 0.5 * (cuu + cww), gap = std::sqrt(0.25 * (cuu - cww) * (cuu - cww) + cuw * cuw);
+  out.largest = std::sqrt(std::max(half + gap, 0.0));
+  // C in rest space: cuu u u^T + cww w w^T + cuw (u w^T + w u^T).
+  const auto entry = [&](int i, int j) {
+    return cuu * u[i] * u[j] + cww * w[i] * w[j] + cuw * (u[i] * w[j] + w[i] * u[j]);
+  };
+  out.tensor = {entry(0, 0), entry(1, 1), entry(2, 2), entry(0, 1), entry(0, 2), entry(1, 2)};
+  return out;
+}
+
+// The largest eigenvalue of a symmetric tensor and its unit eigenvector, by power iteration from `start`.
+Real largestEigen(const std::array<Real, 6>& m, Vec3 start, Vec3& direction) {
+  const auto apply = [&](Vec3 v) {
+    return Vec3{m[0] * v.x + m[3] * v.y + m[4] * v.z, m[3] * v.x + m[1] * v.y + m[5] * v.z,
+                m[4] * v.x + m[5] * v.y + m[2] * v.z};
+  };
+  Vec3 v = glm::length(start) > 0.0 ? glm::normalize(start) : Vec3{1.0, 0.0, 0.0};
+  for (int k = 0; k < 24; ++k) {
+    const Vec3 next = apply(v);
+    const Real length = glm::length(next);
+    if (!(length > 0.0)) break;
+    v = next / length;
+  }
+  direction = v;
+  return glm::dot(v, apply(v));
+}
+
+constexpr int kTearPasses = 8;   // breaking passes a step at most, the cloth relaxed between them
+constexpr int kRelaxSweeps = 4;  // Gauss-Seidel sweeps over the stretch links near a fresh crack
+constexpr int kRelaxRings = 3;   // ... within this many rings of triangles of it
+
+// Breaks the fan of particle v along the line through it perpendicular to `pull` (rest space): on
+// both sides where v lies inside the cloth, else on the side that runs into the cloth, away from
+// the border (a crack's tip runs on ahead). Returns whether it opened anything.
+bool breakAt(Cloth& cloth, ParticleIndex v, Vec3 pull, const Incidence& incidence, std::size_t& particleBudget,
+             std::vector<ParticleInsert>& inserted, Opening& opening) {
+  const ClothRest& rest = cloth.rest;
+  const Topology& topology = cloth.topology;
+  const std::size_t n0 = rest.particleCount();
+  const Vec3 at = rest.restPosition(v);
+  std::vector<std::uint32_t> fan(incidence.begin(v), incidence.end(v));
+  if (fan.empty()) return false;
+  Vec3 normal{0.0};
+  std::vector<Vec3> border;  // directions of the border edges at v
+  for (const std::uint32_t t : fan) {
+    const Triangle& c = rest.triangles[t];
+    normal += glm::cross(rest.restPosition(c[1]) - rest.restPosition(c[0]),
+                         rest.restPosition(c[2]) - rest.restPosition(c[0]));
+    const int cv = cornerOf(c, v);
+    if (topology.neighbour[t][static_cast<std::size_t>(cv)] < 0)
+      border.push_back(rest.restPosition(c[(cv + 1) % 3]) - at);
+    if (topology.neighbour[t][static_cast<std::size_t>((cv + 2) % 3)] < 0)
+      border.push_back(rest.restPosition(c[(cv + 2) % 3]) - at);
+  }
+  if (!(glm::length(normal) > 0.0) || !(glm::length(pull) > 0.0)) return false;
+  normal = glm::normalize(normal);
+  pull = glm::normalize(pull - glm::dot(pull, normal) * normal);
+  const Vec3 crack = glm::normalize(glm::cross(normal, pull));
+  // Which way the crack runs: both ways from inside the cloth; from a border, the way into the
+  // cloth (inside one of v's triangles) farthest from the border's edges.
+  Real way = 0.0;  // 0: both; else +1 or -1 along `crack`
+  if (!border.empty()) {
+    Real best = 2.0;
+    for (const Real sign : {1.0, -1.0}) {
+      const Vec3 ray = sign * crack;
+      bool inside = false;
+      for (const std::uint32_t t : fan) {
+        const Triangle& c = rest.triangles[t];
+        const int cv = cornerOf(c, v);
+        const Vec3 p = rest.restPosition(c[(cv + 1) % 3]) - at, q = rest.restPosition(c[(cv + 2) % 3]) - at;
+        if (glm::dot(glm::cross(p, ray), normal) >= 0.0 && glm::dot(glm::cross(ray, q), normal) >= 0.0) inside = true;
+      }
+      if (!inside) continue;
+      Real closest = -1.0;  // the largest cosine to a border edge
+      for (const Vec3& b : border) closest = std::max(closest, glm::dot(ray, glm::normalize(b)));
+      if (closest < best) {
+        best = closest;
+        way = sign;
+      }
+    }
+    // A corner (no way into the cloth), or a way within 30 degrees of the border: it would cut off
+    // a sliver.
+    if (way == 0.0 || best > 0.866) return false;
+  }
+  const auto ahead = [&](Vec3 x) { return way == 0.0 || way * glm::dot(x - at, crack) > 0.0; };
+  const Real onLine = kOnLine * topology.spacing;
+  Line line;
+  line.distance.resize(n0);
+  line.side.resize(n0);
+  line.onCut.assign(n0, 0);
+  line.joins.assign(n0, 0);
+  for (std::size_t p = 0; p < n0; ++p) {
+    const Real d = glm::dot(rest.restPosition(p) - at, pull);
+    line.distance[p] = d;
+    line.side[p] = std::abs(d) < onLine ? 0 : d > 0.0 ? 1 : -1;
+  }
+  line.onCut[v] = 1;
+  for (const std::uint32_t t : fan) {
+    for (int k = 0; k < 3; ++k) {
+      const ParticleIndex p = rest.triangles[t][k];
+      if (p != v && line.side[p] == 0 && ahead(rest.restPosition(p))) line.onCut[p] = 1;
+    }
+  }
+  line.counts = [&](ParticleIndex p, ParticleIndex q, Real s) {
+    return ahead(glm::mix(rest.restPosition(p), rest.restPosition(q), s));
+  };
+  const bool before = opening.changed;
+  opening.changed = false;
+  openAlong(cloth, line, &fan, particleBudget, inserted, opening);
+  const bool opened = opening.changed;
+  opening.changed = before || opened;
+  return opened;
+}
+
+// A few sweeps over the stretch and shear links within kRelaxRings of the particles `from`, so the
+// flanks of a fresh crack let go of their tension before the next pass decides where it runs on.
+void relax(Cloth& cloth, const std::vector<ParticleIndex>& from) {
+  ClothRest& rest = cloth.rest;
+  ParticleState& s = cloth.state;
+  const Incidence incidence(rest.triangles, rest.particleCount());
+  std::vector<std::uint8_t> inside(rest.particleCount(), 0);
+  std::vector<ParticleIndex> ring = from;
+  for (const ParticleIndex p : ring) inside[p] = 1;
+  for (int r = 0; r < kRelaxRings; ++r) {
+    std::vector<ParticleIndex> next;
+    for (const ParticleIndex p : ring) {
+      for (auto t = incidence.begin(p); t != incidence.end(p); ++t) {
+        for (int k = 0; k < 3; ++k) {
+          const ParticleIndex q = rest.triangles[*t][k];
+          if (!inside[q]) {
+            inside[q] = 1;
+            next.push_back(q);
+          }
+        }
+      }
+    }
+    ring = std::move(next);
+  }
+  for (int sweep = 0; sweep < kRelaxSweeps; ++sweep) {
+    for (const ConstraintKind kind : {ConstraintKind::stretch, ConstraintKind::shear}) {
+      for (const DistanceConstraint& c : rest.of(kind)) {
+        if (!inside[c.a] && !inside[c.b]) continue;
+        const Real wa = s.inverseMass[c.a], wb = s.inverseMass[c.b];
+        if (!(wa + wb > 0.0)) continue;
+        const Vec3 d = s.position[c.b] - s.position[c.a];
+        const Real length = glm::length(d);
+        if (!(length > 0.0)) continue;
+        const Vec3 correction = (length - static_cast<Real>(c.restLength)) / (length * (wa + wb)) * d;
+        s.position[c.a] += wa * correction;
+        s.position[c.b] -= wb * correction;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<ParticleSplit>& splits,
+          std::vector<ParticleInsert>& inserted) {
+  bool changed = false;
+  // A link no triangle witnesses (a chain) breaks alone in its piece: the most strained one, which
+  // lets the rest go. Where links are strained alike (a chain pulled evenly), which of them crosses
+  // the threshold first is rounding, and breaking them all would shatter the chain.
+  {
+    const ParticleState& s = cloth.state;
+    const auto& stretch = cloth.rest.of(ConstraintKind::stretch);
+    std::vector<std::pair<Real, std::uint32_t>> strained;
+    for (std::uint32_t j = 0; j < stretch.size(); ++j) {
+      const DistanceConstraint& c = stretch[j];
+      const Real length = glm::length(s.position[c.b] - s.position[c.a]);
+      if (length > threshold * c.restLength) strained.push_back({length / c.restLength, j});
+    }
+    if (!strained.empty()) {
+      build(cloth);
+      std::sort(strained.begin(), strained.end(), [](const auto& l, const auto& r) {
+        return l.first > r.first || (l.first == r.first && l.second < r.second);
+      });
+      Topology& topology = cloth.topology;
+      std::vector<std::uint32_t> letGo;  // pieces a free link of has broken
+      for (const auto& [ratio, j] : strained) {
+        ConstraintTemplate& x =
+            topology.templates[topology.source[static_cast<std::size_t>(ConstraintKind::stretch)][j]];
+        if (x.link != ConstraintTemplate::Link::free) continue;
+        const std::uint32_t piece = stretch[j].a < cloth.piece.size() ? cloth.piece[stretch[j].a] : 0;
+        if (std::find(letGo.begin(), letGo.end(), piece) != letGo.end()) continue;
+        letGo.push_back(piece);
+        x.broken = true;
+        ++topology.torn;
+        changed = true;
+      }
+      if (changed) rebuildConstraints(cloth);
+    }
+  }
+  // Triangles: a particle breaks where the stretch of its triangles (their C = F^T F averaged by
+  // area) has a principal stretch beyond the threshold, across that principal direction.
+  for (int pass = 0; pass < kTearPasses; ++pass) {
+    const ClothRest& rest = cloth.rest;
+    const std::size_t n = rest.particleCount(), triangles = rest.triangles.size();
+    std::vector<Stretch> stretch(triangles);
+    bool any = false;
+    for (std::size_t t = 0; t < triangles; ++t) {
+      stretch[t] = triangleStretch(cloth, rest.triangles[t]);
+      if (stretch[t].largest > threshold) any = true;
+    }
+    if (!any) break;
+    build(cloth);
+    const Incidence incidence(rest.triangles, n);
+    // The particles of overstretched triangles, as candidates, the most stretched first.
+    std::vector<std::uint8_t> candidate(n, 0);
+    for (std::size_t t = 0; t < triangles; ++t) {
+      if (stretch[t].largest <= threshold) continue;
+      for (int k = 0; k < 3; ++k) candidate[rest.triangles[t][k]] = 1;
+    }
+    // A crack's tip (on a border, its triangles all around it but for the slit) breaks as its most
+    // stretched triangle does, across that triangle's pull: stress gathers there. Anywhere else a
+    // particle breaks as its triangles do on average, and a crack starts so at most once a step
+    // (the most stretched particle), so cracks run on rather than start everywhere at once.
+    const auto onBorder = [&](ParticleIndex p) {
+      for (auto t = incidence.begin(p); t != incidence.end(p); ++t) {
+        const int cp = cornerOf(cloth.rest.triangles[*t], p);
+        if (cloth.topology.neighbour[*t][static_cast<std::size_t>(cp)] < 0 ||
+            cloth.topology.neighbour[*t][static_cast<std::size_t>((cp + 2) % 3)] < 0)
+          return true;
+      }
+      return false;
+    };
+    struct Break {
+      Real stretch;
+      ParticleIndex particle;
+      Vec3 pull;
+      bool tip;
+    };
+    std::vector<Break> breaks;
+    for (std::size_t p = 0; p < n; ++p) {
+      if (!candidate[p]) continue;
+      const auto v = static_cast<ParticleIndex>(p);
+      std::array<Real, 6> sum{};
+      Real area = 0.0, most = 0.0, angle = 0.0;
+      Vec3 mostPull{0.0};
+      for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
+        const Triangle& c = rest.triangles[*t];
+        const Real a = triangleArea(rest, c);
+        for (std::size_t k = 0; k < 6; ++k) sum[k] += a * stretch[*t].tensor[k];
+        area += a;
+        const int cv = cornerOf(c, v);
+        const Vec3 e1 = rest.restPosition(c[(cv + 1) % 3]) - rest.restPosition(v);
+        const Vec3 e2 = rest.restPosition(c[(cv + 2) % 3]) - rest.restPosition(v);
+        if (glm::length(e1) > 0.0 && glm::length(e2) > 0.0)
+          angle += std::acos(std::clamp(glm::dot(glm::normalize(e1), glm::normalize(e2)), -1.0, 1.0));
+        if (stretch[*t].largest > most) {
+          most = stretch[*t].largest;
+          largestEigen(stretch[*t].tensor, Vec3{1.0, 0.7, 0.3}, mostPull);
+        }
+      }
+      if (!(area > 0.0)) continue;
+      for (Real& e : sum) e /= area;
+      Vec3 pull;
+      const Real value = std::sqrt(std::max(largestEigen(sum, mostPull, pull), 0.0));
+      const bool tip = angle > 1.5 * 3.141592653589793 && onBorder(v);
+      if (tip && most > threshold) {
+        // The way a tip runs: across the pull of the triangles within two rings of it, which
+        // smooths out the tip's own field (it turns sharply around a slit's end).
+        std::vector<std::uint32_t> ring;
+        for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
+          for (int k = 0; k < 3; ++k) {
+            const ParticleIndex q = rest.triangles[*t][k];
+            ring.insert(ring.end(), incidence.begin(q), incidence.end(q));
+          }
+        }
+        std::sort(ring.begin(), ring.end());
+        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+        std::array<Real, 6> wide{};
+        for (const std::uint32_t t : ring) {
+          const Real a = triangleArea(rest, rest.triangles[t]);
+          for (std::size_t k = 0; k < 6; ++k) wide[k] += a * stretch[t].tensor[k];
+        }
+        largestEigen(wide, pull, pull);
+        breaks.push_back({most, v, pull, true});
+      } else if (!tip && value > threshold) {
+        breaks.push_back({value, v, pull, false});
+      }
+    }
+    std::sort(breaks.begin(), breaks.end(), [](const Break& l, const Break& r) {
+      return l.stretch > r.stretch || (l.stretch == r.stretch && l.particle < r.particle);
+    });
+    // One break per neighbourhood and pass: the particles of a broken fan wait for the next pass,
+    // after the relaxation, so neighbouring breaks do not cut out slivers and islands between them.
+    std::vector<std::uint8_t> near(n, 0);
+    Opening opening;
+    std::vector<ParticleIndex> broken;
+    const std::size_t insertedBefore = inserted.size();
+    bool started = pass > 0;
+    for (const Break& b : breaks) {
+      if (near[b.particle] || (!b.tip && started)) continue;
+      if (!breakAt(cloth, b.particle, b.pull, incidence, particleBudget, inserted, opening)) continue;
+      if (!b.tip) started = true;
+      broken.push_back(b.particle);
+      // Its fan's particles, and those of every triangle around them: the triangles this break
+      // split (the fan, and those across its outer edges) are out of date in `incidence` now.
+      for (auto t = incidence.begin(b.particle); t != incidence.end(b.particle); ++t) {
+        for (int k = 0; k < 3; ++k) {
+          const ParticleIndex q = cloth.rest.triangles[*t][k];
+          if (q >= n) continue;
+          for (auto u = incidence.begin(q); u != incidence.end(q); ++u) {
+            for (int e = 0; e < 3; ++e) {
+              if (cloth.rest.triangles[*u][e] < n) near[cloth.rest.triangles[*u][e]] = 1;
+            }
+          }
+        }
+      }
+    }
+    if (!opening.changed) break;
+    finishOpening(cloth, opening, particleBudget, splits);
+    changed = true;
+    for (std::size_t k = insertedBefore; k < inserted.size(); ++k) broken.push_back(inserted[k].particle);
+    relax(cloth, broken);
+  }
+  return changed;
 }
 
 std::vector<std::uint32_t> pieces(const ClothRest& rest, std::uint32_t& count) {

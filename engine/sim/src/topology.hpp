@@ -13,11 +13,17 @@ namespace drape::sim::topology {
 // Builds the neighbours, rest areas and constraint templates from the cloth's mesh, once.
 void build(Cloth& cloth);
 
-// Every stretch constraint longer than `threshold` times its rest length tears: the fan of one of
-// its ends is severed across the pull (along the line through that end perpendicular to the
-// constraint, at rest), and the particle splits. A constraint no triangle witnesses breaks.
-// At most `particleBudget` particles are made. Returns whether the mesh changed.
-bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<ParticleSplit>& splits);
+// Tearing through the triangles. Where a particle's triangles are stretched (C = F^T F of their
+// deformation, averaged by area) with a principal stretch beyond `threshold`, its fan breaks along
+// the line through it across that principal direction (at rest), as a cut does: new particles where
+// the line crosses the fan's edges, the fan's triangles split, the mesh opened; from inside the
+// cloth both ways, from a border (a crack's tip) the way into the cloth. One break per
+// neighbourhood a pass; up to kTearPasses passes a step, the links near each fresh crack relaxed
+// between them, so a crack runs as far in a step as the tension drives it. A link no triangle
+// witnesses (a chain) breaks alone in its piece, the most strained one. At most `particleBudget`
+// particles are made. Returns whether the mesh changed.
+bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<ParticleSplit>& splits,
+          std::vector<ParticleInsert>& inserted);
 
 // Cuts along the surface swept by the segment a-b moved along `depth` (both ways, without end), through
 // the triangles: a particle within a fifth of the spacing of that surface is moved onto it (along an

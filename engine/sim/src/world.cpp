@@ -931,12 +931,14 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
 
 void World::tear() {
   std::vector<ParticleSplit> splits;
+  std::vector<ParticleInsert> inserted;
   for (std::size_t c = 0; c < cloths_.size(); ++c) {
     splits.clear();
+    inserted.clear();
     const std::size_t budget =
         static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
-    if (!topology::tear(cloths_[c], settings_.tearing.threshold, budget, splits)) continue;
-    afterTopologyChange(c, splits);
+    if (!topology::tear(cloths_[c], settings_.tearing.threshold, budget, splits, inserted)) continue;
+    afterTopologyChange(c, splits, inserted);
   }
 }
 
