@@ -267,6 +267,31 @@ void splitParticles(Cloth& cloth, std::vector<ParticleIndex> touched, std::size_
   }
 }
 
+// A triangle's edge, by the particles at its ends (lower << 32 | higher).
+struct EdgeUse {
+  std::uint64_t key;
+  std::uint32_t triangle;
+  int edge;
+};
+
+// Joins each two triangles that use the same edge; an edge of three or more joins none of them.
+void joinAlongEdges(Topology& topology, std::vector<EdgeUse>& uses) {
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& l, const EdgeUse& r) {
+    return std::tie(l.key, l.triangle, l.edge) < std::tie(r.key, r.triangle, r.edge);
+  });
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    if (j - i == 2) {
+      topology.neighbour[uses[i].triangle][static_cast<std::size_t>(uses[i].edge)] =
+          static_cast<std::int32_t>(uses[i + 1].triangle);
+      topology.neighbour[uses[i + 1].triangle][static_cast<std::size_t>(uses[i + 1].edge)] =
+          static_cast<std::int32_t>(uses[i].triangle);
+    }
+    i = j;
+  }
+}
+
 // Every constraint's recipes, from the constraints and triangles as they are now: as a world
 // loaded from a snapshot of this one would make them, so the two run on alike.
 void makeTemplates(Cloth& cloth) {
@@ -294,11 +319,6 @@ void build(Cloth& cloth) {
   topology.neighbour.assign(triangles.size(), {-1, -1, -1});
   topology.triangleArea.resize(triangles.size());
   // Pair up the triangles on each edge; an edge of three or more triangles joins none of them.
-  struct EdgeUse {
-    std::uint64_t key;
-    std::uint32_t triangle;
-    int edge;
-  };
   std::vector<EdgeUse> uses;
   uses.reserve(triangles.size() * 3);
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
@@ -310,20 +330,7 @@ void build(Cloth& cloth) {
       uses.push_back({lo << 32 | hi, t, k});
     }
   }
-  std::sort(uses.begin(), uses.end(), [](const EdgeUse& l, const EdgeUse& r) {
-    return std::tie(l.key, l.triangle) < std::tie(r.key, r.triangle);
-  });
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i;
-    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
-    if (j - i == 2) {
-      topology.neighbour[uses[i].triangle][static_cast<std::size_t>(uses[i].edge)] =
-          static_cast<std::int32_t>(uses[i + 1].triangle);
-      topology.neighbour[uses[i + 1].triangle][static_cast<std::size_t>(uses[i + 1].edge)] =
-          static_cast<std::int32_t>(uses[i].triangle);
-    }
-    i = j;
-  }
+  joinAlongEdges(topology, uses);
   makeTemplates(cloth);
   // The scale a cut snaps at: the spacing the cloth was made with (so a snapshot, which keeps the
   // settings, snaps as the world it was taken from); else the median stretch rest length.
@@ -648,12 +655,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
     if (s.inverseMass[giver] > 0.0) s.inverseMass[giver] = 1.0 / s.mass[giver];
   }
   // Join the children to each other and to their parents' neighbours, across the edges that were joined.
-  struct Use {
-    std::uint64_t key;
-    std::uint32_t triangle;
-    int edge;
-  };
-  std::vector<Use> uses;
+  std::vector<EdgeUse> uses;
   for (const Split& sp : split) {
     for (const Split::Child& child : sp.children) {
       topology.neighbour[child.index] = {-1, -1, -1};
@@ -676,20 +678,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
       }
     }
   }
-  std::sort(uses.begin(), uses.end(), [](const Use& l, const Use& r) {
-    return std::tie(l.key, l.triangle, l.edge) < std::tie(r.key, r.triangle, r.edge);
-  });
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i;
-    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
-    if (j - i == 2) {
-      topology.neighbour[uses[i].triangle][static_cast<std::size_t>(uses[i].edge)] =
-          static_cast<std::int32_t>(uses[i + 1].triangle);
-      topology.neighbour[uses[i + 1].triangle][static_cast<std::size_t>(uses[i + 1].edge)] =
-          static_cast<std::int32_t>(uses[i].triangle);
-    }
-    i = j;
-  }
+  joinAlongEdges(topology, uses);
   // Sever the cut: the children's edge along it, and the old edges with both ends on it that part
   // triangles on opposite sides.
   for (const Split& sp : split) {
