@@ -758,8 +758,9 @@ void finishOpening(Cloth& cloth, Opening& opening, std::size_t particleBudget, s
     }
   }
   // Recipes afresh: those found again in split triangles may name other witnesses than a fresh
-  // search (a snapshot loaded) finds.
+  // search (a snapshot loaded) finds. The rest frames are made again when next needed.
   makeTemplates(cloth);
+  topology.restFrames.clear();
 }
 
 }  // namespace
@@ -848,16 +849,23 @@ struct Stretch {
   Real largest = 0.0;
 };
 
-Stretch triangleStretch(const Cloth& cloth, const Triangle& t) {
-  const ClothRest& rest = cloth.rest;
-  const std::vector<Vec3>& x = cloth.state.position;
+Topology::RestFrame restFrame(const ClothRest& rest, const Triangle& t) {
   const Vec3 e1 = rest.restPosition(t[1]) - rest.restPosition(t[0]);
   const Vec3 e2 = rest.restPosition(t[2]) - rest.restPosition(t[0]);
   const Real l1 = glm::length(e1);
   const Vec3 n = glm::cross(e1, e2);
-  if (!(l1 > 0.0) || !(glm::length(n) > 0.0)) return {};
+  if (!(l1 > 0.0) || !(glm::length(n) > 0.0)) return {glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, 0.0f, 0.0f};
   const Vec3 u = e1 / l1, w = glm::normalize(glm::cross(n, u));
-  const Real a = l1, b = glm::dot(u, e2), d = glm::dot(w, e2);  // Dm = [[a, b], [0, d]]
+  return {glm::vec3(u), glm::vec3(w), static_cast<float>(l1), static_cast<float>(glm::dot(u, e2)),
+          static_cast<float>(glm::dot(w, e2))};
+}
+
+Stretch triangleStretch(const Cloth& cloth, const Triangle& t, const Topology::RestFrame& frame,
+                        bool withTensor = true) {
+  if (!(frame.a > 0.0f) || !(frame.d != 0.0f)) return {};
+  const std::vector<Vec3>& x = cloth.state.position;
+  const Vec3 u(frame.u), w(frame.w);
+  const Real a = frame.a, b = frame.b, d = frame.d;  // Dm = [[a, b], [0, d]]
   const Vec3 s1 = x[t[1]] - x[t[0]], s2 = x[t[2]] - x[t[0]];
   // F = Ds Dm^-1: its columns, the images of u and w.
   const Vec3 fu = s1 / a, fw = (s2 - b * fu) / d;
@@ -865,6 +873,7 @@ Stretch triangleStretch(const Cloth& cloth, const Triangle& t) {
   Stretch out;
   const Real half = 0.5 * (cuu + cww), gap = std::sqrt(0.25 * (cuu - cww) * (cuu - cww) + cuw * cuw);
   out.largest = std::sqrt(std::max(half + gap, 0.0));
+  if (!withTensor) return out;
   // C in rest space: cuu u u^T + cww w w^T + cuw (u w^T + w u^T).
   const auto entry = [&](int i, int j) {
     return cuu * u[i] * u[j] + cww * w[i] * w[j] + cuw * (u[i] * w[j] + w[i] * u[j]);
@@ -1061,19 +1070,26 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
   for (int pass = 0; pass < kTearPasses; ++pass) {
     const ClothRest& rest = cloth.rest;
     const std::size_t n = rest.particleCount(), triangles = rest.triangles.size();
-    std::vector<Stretch> stretch(triangles);
+    std::vector<Topology::RestFrame>& frames = cloth.topology.restFrames;
+    if (frames.size() != triangles) {
+      frames.resize(triangles);
+      for (std::size_t t = 0; t < triangles; ++t) frames[t] = restFrame(rest, rest.triangles[t]);
+    }
+    // Each triangle's principal stretch; its whole tensor only where a particle is looked at.
+    std::vector<Real> largest(triangles);
     bool any = false;
     for (std::size_t t = 0; t < triangles; ++t) {
-      stretch[t] = triangleStretch(cloth, rest.triangles[t]);
-      if (stretch[t].largest > threshold) any = true;
+      largest[t] = triangleStretch(cloth, rest.triangles[t], frames[t], false).largest;
+      if (largest[t] > threshold) any = true;
     }
+    const auto tensorOf = [&](std::uint32_t t) { return triangleStretch(cloth, rest.triangles[t], frames[t]).tensor; };
     if (!any) break;
     build(cloth);
     const Incidence incidence(rest.triangles, n);
     // The particles of overstretched triangles, as candidates, the most stretched first.
     std::vector<std::uint8_t> candidate(n, 0);
     for (std::size_t t = 0; t < triangles; ++t) {
-      if (stretch[t].largest <= threshold) continue;
+      if (largest[t] <= threshold) continue;
       for (int k = 0; k < 3; ++k) candidate[rest.triangles[t][k]] = 1;
     }
     // A crack's tip (on a border, its triangles all around it but for the slit) breaks as its most
@@ -1105,16 +1121,17 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
       for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
         const Triangle& c = rest.triangles[*t];
         const Real a = triangleArea(rest, c);
-        for (std::size_t k = 0; k < 6; ++k) sum[k] += a * stretch[*t].tensor[k];
+        const std::array<Real, 6> tensor = tensorOf(*t);
+        for (std::size_t k = 0; k < 6; ++k) sum[k] += a * tensor[k];
         area += a;
         const int cv = cornerOf(c, v);
         const Vec3 e1 = rest.restPosition(c[(cv + 1) % 3]) - rest.restPosition(v);
         const Vec3 e2 = rest.restPosition(c[(cv + 2) % 3]) - rest.restPosition(v);
         if (glm::length(e1) > 0.0 && glm::length(e2) > 0.0)
           angle += std::acos(std::clamp(glm::dot(glm::normalize(e1), glm::normalize(e2)), -1.0, 1.0));
-        if (stretch[*t].largest > most) {
-          most = stretch[*t].largest;
-          largestEigen(stretch[*t].tensor, Vec3{1.0, 0.7, 0.3}, mostPull);
+        if (largest[*t] > most) {
+          most = largest[*t];
+          largestEigen(tensor, Vec3{1.0, 0.7, 0.3}, mostPull);
         }
       }
       if (!(area > 0.0)) continue;
@@ -1137,7 +1154,8 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
         std::array<Real, 6> wide{};
         for (const std::uint32_t t : ring) {
           const Real a = triangleArea(rest, rest.triangles[t]);
-          for (std::size_t k = 0; k < 6; ++k) wide[k] += a * stretch[t].tensor[k];
+          const std::array<Real, 6> tensor = tensorOf(t);
+          for (std::size_t k = 0; k < 6; ++k) wide[k] += a * tensor[k];
         }
         largestEigen(wide, pull, pull);
         breaks.push_back({most, v, pull, true});

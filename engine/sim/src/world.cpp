@@ -407,8 +407,8 @@ MemoryUse World::memoryUse() const {
     m.state += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) +
                bytes(s.mass) + bytes(s.pinned);
     const Topology& t = cloth.topology;
-    m.topology +=
-        bytes(t.neighbour) + bytes(t.triangleArea) + bytes(t.templates) + bytes(t.source) + bytes(cloth.piece);
+    m.topology += bytes(t.neighbour) + bytes(t.triangleArea) + bytes(t.templates) + bytes(t.source) +
+                  bytes(t.restFrames) + bytes(cloth.piece);
   }
   for (const SolverScratch& s : scratch_) {
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +

@@ -19,6 +19,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "drape/sim/cloth.hpp"
 #include "drape/sim/types.hpp"
 
@@ -63,7 +65,14 @@ struct Topology {
   std::size_t torn = 0;  // edges severed and links broken so far (tearing and cutting)
   // Per current constraint, by kind: the template it came from.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> source;
-  Real spacing = 0.0;  // m, the median stretch rest length when built: the scale cuts snap at
+  // Per triangle, for tearing: its rest frame (u, w: unit vectors in its plane at rest) and the
+  // edges' coordinates in it (corner 1 at (a, 0), corner 2 at (b, d)); made again after a change.
+  struct RestFrame {
+    glm::vec3 u, w;
+    float a, b, d;
+  };
+  std::vector<RestFrame> restFrames;
+  Real spacing = 0.0;  // m, the spacing the cloth was made with: the scale cuts snap at
   // Where the last cut segment ended inside a triangle: the particles it left on that triangle's
   // edge, which the next segment of the same swipe (starting at `cutEnd`) carries the cut on from.
   std::vector<ParticleIndex> cutTips;
