@@ -422,6 +422,15 @@ struct Line {
   std::vector<std::uint8_t> onCut;  // per particle: on the line and part of the opening
   std::vector<std::uint8_t> joins;  // per particle: an opening reaching its triangle runs on to it (a swipe's tips)
   std::function<bool(ParticleIndex, ParticleIndex, Real)> counts;  // whether edge p-q's crossing at p + s (q - p) is
+  Real onLine = 0.0;                                               // m: kOnLine spacings
+
+  Line(std::size_t particles, Real spacing)
+      : distance(particles), side(particles), onCut(particles, 0), joins(particles, 0), onLine(kOnLine * spacing) {}
+  // Particle p lies `d` metres from the plane.
+  void place(std::size_t p, Real d) {
+    distance[p] = d;
+    side[p] = std::abs(d) < onLine ? 0 : d > 0.0 ? 1 : -1;
+  }
 };
 
 // What openings have done that the constraints and particles must follow (finishOpening).
@@ -787,19 +796,12 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
     const Real u = ahead(x);
     return u >= 0.0 && u <= length;
   };
-  const Real onLine = kOnLine * topology.spacing;
-  Line line;
-  line.distance.resize(n0);
-  line.side.resize(n0);
-  line.onCut.assign(n0, 0);
-  line.joins.assign(n0, 0);
+  Line line(n0, topology.spacing);
   for (const ParticleIndex p : tips) {
     if (p < n0) line.joins[p] = 1;
   }
   for (std::size_t p = 0; p < n0; ++p) {
-    const Real d = glm::dot(s.position[p] - a, normal);
-    line.distance[p] = d;
-    line.side[p] = std::abs(d) < onLine ? 0 : d > 0.0 ? 1 : -1;
+    line.place(p, glm::dot(s.position[p] - a, normal));
     // A point of the cut on a particle: one on the line, within the swipe (or where the last segment left off).
     line.onCut[p] = line.side[p] == 0 && (within(s.position[p]) || line.joins[p]);
   }
@@ -957,17 +959,8 @@ bool breakAt(Cloth& cloth, ParticleIndex v, Vec3 pull, const Incidence& incidenc
     if (way == 0.0 || best > 0.866) return false;
   }
   const auto ahead = [&](Vec3 x) { return way == 0.0 || way * glm::dot(x - at, crack) > 0.0; };
-  const Real onLine = kOnLine * topology.spacing;
-  Line line;
-  line.distance.resize(n0);
-  line.side.resize(n0);
-  line.onCut.assign(n0, 0);
-  line.joins.assign(n0, 0);
-  for (std::size_t p = 0; p < n0; ++p) {
-    const Real d = glm::dot(rest.restPosition(p) - at, pull);
-    line.distance[p] = d;
-    line.side[p] = std::abs(d) < onLine ? 0 : d > 0.0 ? 1 : -1;
-  }
+  Line line(n0, topology.spacing);
+  for (std::size_t p = 0; p < n0; ++p) line.place(p, glm::dot(rest.restPosition(p) - at, pull));
   line.onCut[v] = 1;
   for (const std::uint32_t t : fan) {
     for (int k = 0; k < 3; ++k) {
