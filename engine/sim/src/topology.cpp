@@ -5,6 +5,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <tuple>
 
 #include <glm/geometric.hpp>
@@ -1166,18 +1167,21 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     std::vector<ParticleIndex> broken;
     const std::size_t insertedBefore = inserted.size();
     bool started = pass > 0;
+    // The triangles around each particle as they are now: made again after every break (a break
+    // splits triangles and puts new ones at the end).
+    std::optional<Incidence> now;
     for (const Break& b : breaks) {
       if (near[b.particle] || (!b.tip && started)) continue;
-      if (!breakAt(cloth, b.particle, b.pull, incidence, particleBudget, inserted, opening)) continue;
+      if (!now) now.emplace(cloth.rest.triangles, cloth.rest.particleCount());
+      if (!breakAt(cloth, b.particle, b.pull, *now, particleBudget, inserted, opening)) continue;
       if (!b.tip) started = true;
       broken.push_back(b.particle);
-      // Its fan's particles, and those of every triangle around them: the triangles this break
-      // split (the fan, and those across its outer edges) are out of date in `incidence` now.
-      for (auto t = incidence.begin(b.particle); t != incidence.end(b.particle); ++t) {
+      // Its fan's particles, and those of every triangle around them, wait for the next pass.
+      now.emplace(cloth.rest.triangles, cloth.rest.particleCount());
+      for (auto t = now->begin(b.particle); t != now->end(b.particle); ++t) {
         for (int k = 0; k < 3; ++k) {
           const ParticleIndex q = cloth.rest.triangles[*t][k];
-          if (q >= n) continue;
-          for (auto u = incidence.begin(q); u != incidence.end(q); ++u) {
+          for (auto u = now->begin(q); u != now->end(q); ++u) {
             for (int e = 0; e < 3; ++e) {
               if (cloth.rest.triangles[*u][e] < n) near[cloth.rest.triangles[*u][e]] = 1;
             }
