@@ -152,7 +152,7 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
                            {"searches", contact.searches},
                            {"tested", contact.tested},
                            {"triangleTests", contact.triangleTests},
-                           {"cellsWalked", contact.cellsWalked},
+                           {"boxTests", contact.boxTests},
                            {"zoned", contact.zoned},
                            {"fallbacks", contact.fallbacks}}},
                          {"energy",

@@ -30,27 +30,8 @@ constexpr Real kLeverage = 0.25;
 // How many times its rest size a triangle or edge may be stretched and still take part.
 constexpr Real kTorn = 10.0;
 
-// `inverse`: 1 / the cell's size.
-glm::i64vec3 cellOf(Vec3 x, Real inverse) {
-  // The guard keeps positions finite and within 1e6 m between steps, but within a step a box may
-  // be beyond that, or NaN (a fuzzed snapshot's overflow): clamped first, a NaN to the lowest
-  // corner (its box overlaps nothing), the cell always fits.
-  const auto bounded = [](Real v) { return v >= -2.0e6 ? (v <= 2.0e6 ? v : 2.0e6) : -2.0e6; };
-  const Vec3 c = Vec3(bounded(x.x), bounded(x.y), bounded(x.z)) * inverse;
-  return {static_cast<std::int64_t>(std::floor(c.x)), static_cast<std::int64_t>(std::floor(c.y)),
-          static_cast<std::int64_t>(std::floor(c.z))};
-}
-
-std::size_t hashOf(glm::i64vec3 cell, std::size_t mask) {
-  const glm::u64vec3 u(cell);  // wrapping
-  const std::uint64_t h = (u.x * 92837111u) ^ (u.y * 689287499u) ^ (u.z * 283923481u);
-  return static_cast<std::size_t>((h ^ (h >> 29)) & mask);
-}
-
-std::uint64_t cellsIn(glm::i64vec3 lo, glm::i64vec3 hi) {
-  const glm::u64vec3 span(hi - lo + glm::i64vec3(1));
-  return span.x * span.y * span.z;
-}
+// Triangles a leaf of the broad phase's tree holds at most.
+constexpr std::size_t kLeafTriangles = 2;
 
 // Closest point of triangle abc to p, as barycentric weights of a, b, c (by the triangle's Voronoi
 // regions: a corner, an edge, or the inside).
@@ -131,22 +112,6 @@ Vec3 between(const Weights& w, const Vec3& p0, const Vec3& p1, const Vec3& p2, c
   return p0 * w.c[0] + p1 * w.c[1] + p2 * w.c[2] + p3 * w.c[3];
 }
 
-struct GridBuild {
-  const glm::vec3* lower;  // the boxes in single precision, rounded outwards
-  const glm::vec3* upper;
-  std::size_t count;
-};
-
-// Every primitive into each cell its box covers; false (nothing built) if that would be more than
-// `budget` entries.
-// A cell's coordinates in one word: 21 bits each, enough to tell apart the cells of one bucket (cells
-// 2^21 apart along an axis share a word, and are told apart by their boxes: Entry's use below).
-std::uint64_t packed(glm::i64vec3 c) {
-  const glm::u64vec3 u(c);
-  constexpr std::uint64_t mask = (1u << 21) - 1;
-  return (u.x & mask) | ((u.y & mask) << 21) | ((u.z & mask) << 42);
-}
-
 // A box in single precision, grown to hold the double one.
 glm::vec3 below(const Vec3& x) {
   return {std::nextafter(static_cast<float>(x.x), -INFINITY), std::nextafter(static_cast<float>(x.y), -INFINITY),
@@ -157,54 +122,9 @@ glm::vec3 above(const Vec3& x) {
           std::nextafter(static_cast<float>(x.z), INFINITY)};
 }
 
-template <class Entry>
-bool fillGrid(std::vector<std::uint32_t>& start, std::vector<Entry>& entries, glm::i64vec3& lowest,
-              glm::i64vec3& highest, const GridBuild& build, Real inverse, std::uint64_t budget) {
-  std::uint64_t total = 0;
-  lowest = glm::i64vec3(std::numeric_limits<std::int64_t>::max());
-  highest = glm::i64vec3(std::numeric_limits<std::int64_t>::min());
-  // Cells from the boxes as the entries keep them (single precision, rounded outwards): a pair's
-  // overlap then lies in cells both cover (query below).
-  const auto cellsOf = [&](std::size_t i) {
-    return std::pair{cellOf(Vec3(build.lower[i]), inverse), cellOf(Vec3(build.upper[i]), inverse)};
-  };
-  const auto empty = [&](std::size_t i) { return build.lower[i].x > build.upper[i].x; };
-  for (std::size_t i = 0; i < build.count; ++i) {
-    if (empty(i)) continue;
-    const auto [lo, hi] = cellsOf(i);
-    total += cellsIn(lo, hi);
-    if (total > budget) return false;
-    lowest = glm::min(lowest, lo);
-    highest = glm::max(highest, hi);
-  }
-  const std::size_t table = std::bit_ceil(static_cast<std::size_t>(2 * total + 1));
-  const std::size_t mask = table - 1;
-  start.assign(table + 1, 0);
-  const auto each = [&](std::size_t i, auto&& f) {
-    const auto [lo, hi] = cellsOf(i);
-    for (std::int64_t z = lo.z; z <= hi.z; ++z) {
-      for (std::int64_t y = lo.y; y <= hi.y; ++y) {
-        for (std::int64_t x = lo.x; x <= hi.x; ++x) f(glm::i64vec3(x, y, z));
-      }
-    }
-  };
-  for (std::size_t i = 0; i < build.count; ++i) {
-    if (!empty(i)) each(i, [&](glm::i64vec3 c) { ++start[hashOf(c, mask) + 1]; });
-  }
-  for (std::size_t k = 0; k < table; ++k) start[k + 1] += start[k];
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  entries.resize(static_cast<std::size_t>(total));
-  for (std::size_t i = 0; i < build.count; ++i) {
-    if (empty(i)) continue;
-    const glm::i64vec3 first = cellOf(Vec3(build.lower[i]), inverse);
-    each(i, [&](glm::i64vec3 c) {
-      const std::uint32_t k = fill[hashOf(c, mask)]++;
-      const auto starts =
-          static_cast<std::uint8_t>((c.x == first.x ? 1 : 0) | (c.y == first.y ? 2 : 0) | (c.z == first.z ? 4 : 0));
-      entries[k] = {packed(c), static_cast<std::uint32_t>(i), starts, build.lower[i], build.upper[i]};
-    });
-  }
-  return true;
+bool overlap(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& otherLo, const glm::vec3& otherHi) {
+  return lo.x <= otherHi.x && otherLo.x <= hi.x && lo.y <= otherHi.y && otherLo.y <= hi.y && lo.z <= otherHi.z &&
+         otherLo.z <= hi.z;
 }
 
 }  // namespace
@@ -215,9 +135,9 @@ std::size_t SelfContact::bytes() const {
                       b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) + b(upper_) + b(boxLower_) +
                       b(boxUpper_) + b(pairs_) + b(active_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) +
                       b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
-  for (const Grid* g : {&triangleGrid_, &edgeGrid_}) total += b(g->start) + b(g->entries);
+  total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
+           b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
   for (const std::vector<Pair>& found : found_) total += b(found);
-  total += b(walked_);
   return total;
 }
 
@@ -266,6 +186,121 @@ void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
     for (int k = 0; k < 3; ++k) vertexTriangles_[fill[triangles_[t][k]]++] = t;
   }
   meshParticles_ = n;
+  buildTree();
+}
+
+void SelfContact::buildTree() {
+  const std::size_t n = clothOf_.size(), nt = triangles_.size();
+  // The items the tree splits: the triangles (ids 0 .. nt - 1), then the particles in no triangle
+  // (nt + the particle), each at its rest centroid; cloth by cloth.
+  std::vector<std::uint32_t> items;
+  std::vector<Vec3> centre(nt + n);
+  std::vector<std::uint32_t> cloth(nt + n);
+  for (std::uint32_t t = 0; t < nt; ++t) {
+    const glm::uvec3 v = triangles_[t];
+    items.push_back(t);
+    centre[t] = (rest_[v[0]] + rest_[v[1]] + rest_[v[2]]) / 3.0;
+    cloth[t] = clothOf_[v[0]];
+  }
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (vertexStart_[v] != vertexStart_[v + 1]) continue;
+    const auto id = static_cast<std::uint32_t>(nt + v);
+    items.push_back(id);
+    centre[id] = rest_[v];
+    cloth[id] = clothOf_[v];
+  }
+  std::stable_sort(items.begin(), items.end(), [&](std::uint32_t a, std::uint32_t b) { return cloth[a] < cloth[b]; });
+
+  nodes_.clear();
+  leafNode_.clear();
+  leafTriangles_.clear();
+  leafTriangleStart_.assign(1, 0);
+  std::vector<std::uint32_t> leafOfItem(nt + n, kNone);
+  const auto build = [&](auto&& self, std::size_t begin, std::size_t end) -> std::uint32_t {
+    const auto node = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.push_back({});
+    if (end - begin <= kLeafTriangles) {
+      const auto leaf = static_cast<std::uint32_t>(leafNode_.size());
+      leafNode_.push_back(node);
+      nodes_[node].left = leaf;
+      nodes_[node].right = kNone;
+      for (std::size_t i = begin; i < end; ++i) {
+        leafOfItem[items[i]] = leaf;
+        if (items[i] < nt) leafTriangles_.push_back(items[i]);
+      }
+      leafTriangleStart_.push_back(static_cast<std::uint32_t>(leafTriangles_.size()));
+      return node;
+    }
+    std::size_t middle = begin + (end - begin) / 2;
+    if (cloth[items[begin]] != cloth[items[end - 1]]) {
+      // Cloths apart: at the border between two cloths nearest the middle.
+      const std::uint32_t c = cloth[items[middle]];
+      const auto byCloth = [&](std::uint32_t item, std::uint32_t value) { return cloth[item] < value; };
+      const auto from = static_cast<std::size_t>(
+          std::lower_bound(items.begin() + begin, items.begin() + end, c, byCloth) - items.begin());
+      const auto to = static_cast<std::size_t>(
+          std::lower_bound(items.begin() + begin, items.begin() + end, c + 1, byCloth) - items.begin());
+      middle = from > begin && (to >= end || middle - from <= to - middle) ? from : to;
+    } else {
+      // Halved at the median along the longest side of the centroids' box.
+      Vec3 lo(std::numeric_limits<Real>::max()), hi(std::numeric_limits<Real>::lowest());
+      for (std::size_t i = begin; i < end; ++i) {
+        lo = glm::min(lo, centre[items[i]]);
+        hi = glm::max(hi, centre[items[i]]);
+      }
+      const Vec3 size = hi - lo;
+      const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+      std::nth_element(items.begin() + begin, items.begin() + middle, items.begin() + end,
+                       [&](std::uint32_t a, std::uint32_t b) {
+                         return centre[a][axis] < centre[b][axis] || (centre[a][axis] == centre[b][axis] && a < b);
+                       });
+    }
+    const std::uint32_t left = self(self, begin, middle);
+    const std::uint32_t right = self(self, middle, end);
+    nodes_[node].left = left;
+    nodes_[node].right = right;
+    return node;
+  };
+  if (!items.empty()) build(build, 0, items.size());
+
+  // Vertices and edges go to the leaf of their first triangle.
+  const std::size_t leaves = leafNode_.size();
+  const auto group = [&](std::vector<std::uint32_t>& start, std::vector<std::uint32_t>& members, std::size_t count,
+                         auto&& leafOf) {
+    start.assign(leaves + 1, 0);
+    for (std::size_t i = 0; i < count; ++i) ++start[leafOf(i) + 1];
+    for (std::size_t l = 0; l < leaves; ++l) start[l + 1] += start[l];
+    members.resize(count);
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < count; ++i) members[fill[leafOf(i)]++] = static_cast<std::uint32_t>(i);
+  };
+  group(leafVertexStart_, leafVertices_, n, [&](std::size_t v) {
+    return vertexStart_[v] != vertexStart_[v + 1] ? leafOfItem[vertexTriangles_[vertexStart_[v]]] : leafOfItem[nt + v];
+  });
+  group(leafEdgeStart_, leafEdges_, edges_.size(), [&](std::size_t e) { return leafOfItem[edgeTriangles_[2 * e]]; });
+}
+
+void SelfContact::fitTree() {
+  const std::size_t n = x_.size(), nt = triangles_.size();
+  const glm::vec3 none(std::numeric_limits<float>::max());
+  for (std::size_t l = 0; l < leafNode_.size(); ++l) {
+    glm::vec3 lo = none, hi = -none;
+    const auto add = [&](std::size_t box) {
+      lo = glm::min(lo, boxLower_[box]);
+      hi = glm::max(hi, boxUpper_[box]);
+    };
+    for (std::uint32_t k = leafVertexStart_[l]; k < leafVertexStart_[l + 1]; ++k) add(leafVertices_[k]);
+    for (std::uint32_t k = leafTriangleStart_[l]; k < leafTriangleStart_[l + 1]; ++k) add(n + leafTriangles_[k]);
+    for (std::uint32_t k = leafEdgeStart_[l]; k < leafEdgeStart_[l + 1]; ++k) add(n + nt + leafEdges_[k]);
+    nodes_[leafNode_[l]].lower = lo;
+    nodes_[leafNode_[l]].upper = hi;
+  }
+  for (std::size_t i = nodes_.size(); i-- > 0;) {
+    Node& node = nodes_[i];
+    if (node.right == kNone) continue;
+    node.lower = glm::min(nodes_[node.left].lower, nodes_[node.right].lower);
+    node.upper = glm::max(nodes_[node.left].upper, nodes_[node.right].upper);
+  }
 }
 
 void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>& scratch) {
@@ -301,8 +336,6 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   const Real grow = distance;
   lower_.resize(n + nt + ne);
   upper_.resize(n + nt + ne);
-  Real extent = 0.0;
-  std::size_t kept = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 to = x0_[i] + (x_[i] - x0_[i]) * ahead;
     lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
@@ -331,12 +364,6 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     }
     lower_[n + t] = glm::min(glm::min(lower_[v[0]], lower_[v[1]]), lower_[v[2]]);
     upper_[n + t] = glm::max(glm::max(upper_[v[0]], upper_[v[1]]), upper_[v[2]]);
-    ++kept;
-    // The cells' size comes from the triangles as they are (plus the growth), not as they sweep:
-    // a patch a finger flings far covers many cells instead of making every cell hold everything.
-    const Vec3 size =
-        glm::max(glm::max(x_[v[0]], x_[v[1]]), x_[v[2]]) - glm::min(glm::min(x_[v[0]], x_[v[1]]), x_[v[2]]);
-    extent += std::max({size.x, size.y, size.z}) + 2.0 * grow;
   }
   for (std::size_t e = 0; e < ne; ++e) {
     const glm::uvec2 v = edges_[e];
@@ -348,152 +375,220 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     lower_[n + nt + e] = glm::min(lower_[v[0]], lower_[v[1]]);
     upper_[n + nt + e] = glm::max(upper_[v[0]], upper_[v[1]]);
   }
-  // Cells about a triangle's box wide; wider while a few huge boxes (a particle flung far) would
-  // fill the grid.
-  cellSize_ = kept > 0 ? std::max(1.5 * extent / static_cast<Real>(kept), 1e-6) : 1.0;
-  // A NaN corner (the guard reports it after the step) makes the extent NaN: any size serves then,
-  // and a NaN one would never fit the grid's budget however often it doubled.
-  if (!std::isfinite(cellSize_)) cellSize_ = 1.0;
-  // The boxes as the grid keeps them: single precision, rounded outwards.
+  // The boxes as the tree keeps them: single precision, rounded outwards.
   boxLower_.resize(n + nt + ne);
   boxUpper_.resize(n + nt + ne);
   for (std::size_t i = 0; i < n + nt + ne; ++i) {
     boxLower_[i] = below(lower_[i]);
     boxUpper_[i] = above(upper_[i]);
   }
-  const std::uint64_t budget = 16 * static_cast<std::uint64_t>(nt + ne) + 4096;
-  while (!fillGrid(triangleGrid_.start, triangleGrid_.entries, triangleGrid_.lowest, triangleGrid_.highest,
-                   {boxLower_.data() + n, boxUpper_.data() + n, nt}, 1.0 / cellSize_, budget) ||
-         !fillGrid(edgeGrid_.start, edgeGrid_.entries, edgeGrid_.lowest, edgeGrid_.highest,
-                   {boxLower_.data() + n + nt, boxUpper_.data() + n + nt, ne}, 1.0 / cellSize_, budget)) {
-    cellSize_ *= 2.0;
+  fitTree();
+  ++stats_.searches;
+
+  // The pairs of leaves whose boxes overlap, each once (a leaf with itself too), in the walk's order.
+  const auto both = [](std::uint32_t a, std::uint32_t b) { return (static_cast<std::uint64_t>(a) << 32) | b; };
+  const auto isLeaf = [&](const Node& node) { return node.right == kNone; };
+  const auto extent = [](const Node& node) {
+    const glm::vec3 size = node.upper - node.lower;
+    return size.x + size.y + size.z;
+  };
+  std::int64_t tests = 0;
+  leafPairs_.clear();
+  stack_.clear();
+  if (!nodes_.empty()) stack_.push_back(both(0, 0));
+  while (!stack_.empty()) {
+    const auto a = static_cast<std::uint32_t>(stack_.back() >> 32), b = static_cast<std::uint32_t>(stack_.back());
+    stack_.pop_back();
+    const Node& p = nodes_[a];
+    const Node& q = nodes_[b];
+    if (a == b) {
+      if (isLeaf(p)) {
+        leafPairs_.push_back(both(p.left, p.left));
+      } else {
+        // Last in, first out: the left half, the right half, then the two against each other.
+        stack_.push_back(both(p.left, p.right));
+        stack_.push_back(both(p.right, p.right));
+        stack_.push_back(both(p.left, p.left));
+      }
+      continue;
+    }
+    ++tests;
+    if (!overlap(p.lower, p.upper, q.lower, q.upper)) continue;
+    if (isLeaf(p) && isLeaf(q)) {
+      leafPairs_.push_back(both(std::min(p.left, q.left), std::max(p.left, q.left)));
+    } else if (!isLeaf(p) && (isLeaf(q) || extent(p) >= extent(q))) {
+      stack_.push_back(both(p.right, b));
+      stack_.push_back(both(p.left, b));
+    } else {
+      stack_.push_back(both(a, q.right));
+      stack_.push_back(both(a, q.left));
+    }
   }
 
-  ++stats_.searches;
-  found_.resize(static_cast<std::size_t>(workers.threads()));
-  // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap.
-  // `accept(other)`: a cheap test of the pair by its indices, after the boxes'.
-  const auto query = [&](const Grid& grid, std::size_t self, std::int64_t& walked, auto&& accept, auto&& emit) {
-    const glm::vec3 lo = boxLower_[self], hi = boxUpper_[self];
-    const Real inverse = 1.0 / cellSize_;
-    const glm::i64vec3 from = cellOf(Vec3(lo), inverse), to = cellOf(Vec3(hi), inverse);
-    // Only the cells that can hold entries; `needs` below still counts from the query's own first
-    // cell, so each pair is found in the same cell as when every cell was walked.
-    const glm::i64vec3 first = glm::max(from, grid.lowest), last = glm::min(to, grid.highest);
-    if (glm::all(glm::lessThanEqual(first, last))) {
-      walked += (last.x - first.x + 1) * (last.y - first.y + 1) * (last.z - first.z + 1);
+  // Whether the two primitives' boxes lie apart along `axis` (a triangle's normal, or across two
+  // edges): the hull of the first `split` corners' boxes and that of the rest. Boxes that overlap
+  // may still: a vertex's box inside a tilted triangle's box, a layer above it. Then, as for boxes
+  // that do not overlap, while every particle keeps half a `distance` inside its box the two stay
+  // at least `distance` apart (each hull shrinks by half a distance along the axis); so the pair is
+  // not listed. Only where they are apart beyond rounding: the margin grows with the coordinates.
+  const auto apart = [&](const std::uint32_t* corners, int split, Vec3 axis) {
+    const Real length = glm::length(axis);
+    if (!(length > 0.0)) return false;
+    axis /= length;
+    const Vec3 size = glm::abs(axis);
+    Real lo[2] = {std::numeric_limits<Real>::max(), std::numeric_limits<Real>::max()};
+    Real hi[2] = {std::numeric_limits<Real>::lowest(), std::numeric_limits<Real>::lowest()};
+    Real scale = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 centre = (lower_[corners[k]] + upper_[corners[k]]) * 0.5;
+      const Real half = glm::dot(upper_[corners[k]] - lower_[corners[k]], size) * 0.5;
+      const Real at = glm::dot(centre, axis);
+      const int side = k < split ? 0 : 1;
+      lo[side] = std::min(lo[side], at - half);
+      hi[side] = std::max(hi[side], at + half);
+      scale = std::max({scale, std::abs(at), half});
     }
-    const std::size_t mask = grid.start.size() - 2;
-    for (std::int64_t z = first.z; z <= last.z; ++z) {
-      for (std::int64_t y = first.y; y <= last.y; ++y) {
-        for (std::int64_t x = first.x; x <= last.x; ++x) {
-          const glm::i64vec3 cell(x, y, z);
-          const std::uint64_t key = packed(cell);
-          const std::size_t bucket = hashOf(cell, mask);
-          // Each pair once: in the cell that holds the lowest corner of the two boxes' overlap. Along
-          // an axis where this cell is past the query's first, that is where the entry's box starts.
-          const auto needs =
-              static_cast<std::uint8_t>((x != from.x ? 1 : 0) | (y != from.y ? 2 : 0) | (z != from.z ? 4 : 0));
-          for (std::uint32_t k = grid.start[bucket]; k < grid.start[bucket + 1]; ++k) {
-            const Entry& e = grid.entries[k];
-            if (e.cell != key || (e.starts & needs) != needs) continue;
-            if (!(lo.x <= e.upper.x && e.lower.x <= hi.x && lo.y <= e.upper.y && e.lower.y <= hi.y &&
-                  lo.z <= e.upper.z && e.lower.z <= hi.z)) {
-              continue;
+    const Real margin = 1e-9 + 1e-12 * scale;
+    return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
+  };
+
+  // How far apart a pair keeps: `distance`, or less for parts of one cloth closer than that at rest.
+  const auto target = [&](const std::uint32_t* v, bool edges) {
+    if (clothOf_[v[0]] != clothOf_[v[2]]) return distance;
+    const Weights rest = edges ? edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])
+                               : vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
+    return std::min(distance, glm::length(between(rest, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])));
+  };
+
+  // Their primitives, in parallel: each thread its run of leaf pairs, joined in that order.
+  const auto threads = static_cast<std::size_t>(workers.threads());
+  found_.resize(2 * threads);
+  boxTests_.assign(threads, 0);
+  for (std::vector<Pair>& found : found_) found.clear();
+  workers.run(
+      leafPairs_.size(),
+      [&](std::size_t begin, std::size_t end, int thread) {
+        std::vector<Pair>& vertexTriangle = found_[2 * static_cast<std::size_t>(thread)];
+        std::vector<Pair>& edgeEdge = found_[2 * static_cast<std::size_t>(thread) + 1];
+        std::int64_t& compared = boxTests_[static_cast<std::size_t>(thread)];
+        // The vertices of leaf `from` against the triangles of leaf `to`: not those it is a corner of.
+        const auto vertices = [&](std::uint32_t from, std::uint32_t to) {
+          const Node& other = nodes_[leafNode_[to]];
+          for (std::uint32_t i = leafVertexStart_[from]; i < leafVertexStart_[from + 1]; ++i) {
+            const std::uint32_t v = leafVertices_[i];
+            const glm::vec3 lo = boxLower_[v], hi = boxUpper_[v];
+            ++compared;
+            if (from != to && !overlap(lo, hi, other.lower, other.upper)) continue;
+            for (std::uint32_t j = leafTriangleStart_[to]; j < leafTriangleStart_[to + 1]; ++j) {
+              const std::uint32_t t = leafTriangles_[j];
+              ++compared;
+              if (!overlap(lo, hi, boxLower_[n + t], boxUpper_[n + t])) continue;
+              const glm::uvec3 c = triangles_[t];
+              if (c[0] == v || c[1] == v || c[2] == v) continue;
+              const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
+              if (apart(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) continue;
+              Pair pair{};
+              for (int k = 0; k < 4; ++k) pair.v[k] = corners[k];
+              pair.target = target(corners, false);
+              pair.first = v;
+              pair.second = t;
+              pair.edges = false;
+              vertexTriangle.push_back(pair);
             }
-            if (!accept(e.index)) continue;
-            emit(e.index);
+          }
+        };
+        for (std::size_t i = begin; i < end; ++i) {
+          const auto l = static_cast<std::uint32_t>(leafPairs_[i] >> 32), m = static_cast<std::uint32_t>(leafPairs_[i]);
+          vertices(l, m);
+          if (l != m) vertices(m, l);
+          // Edge pairs that share no end, each once: within one leaf, the later against the earlier.
+          const Node& other = nodes_[leafNode_[m]];
+          for (std::uint32_t i0 = leafEdgeStart_[l]; i0 < leafEdgeStart_[l + 1]; ++i0) {
+            const std::uint32_t e = leafEdges_[i0];
+            const glm::vec3 lo = boxLower_[n + nt + e], hi = boxUpper_[n + nt + e];
+            ++compared;
+            if (l != m && !overlap(lo, hi, other.lower, other.upper)) continue;
+            for (std::uint32_t i1 = l == m ? i0 + 1 : leafEdgeStart_[m]; i1 < leafEdgeStart_[m + 1]; ++i1) {
+              const std::uint32_t f = leafEdges_[i1];
+              ++compared;
+              if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
+              const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
+              if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
+              const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
+              if (apart(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
+              Pair pair{};
+              for (int k = 0; k < 4; ++k) pair.v[k] = corners[k];
+              pair.target = target(corners, true);
+              pair.first = std::min(e, f);
+              pair.second = std::max(e, f);
+              pair.edges = true;
+              edgeEdge.push_back(pair);
+            }
           }
         }
-      }
-    }
-  };
-  // Every primitive `self` of [0, count) (its box at `boxes + self`) against `grid`, each thread its
-  // run, joined in that order onto pairs_. `accept(self, other)`: a cheap test by indices first.
-  const auto list = [&](std::size_t count, const Grid& grid, std::size_t boxes, auto&& accept, auto&& corners,
-                        bool edges) {
-    for (std::vector<Pair>& found : found_) found.clear();
-    walked_.assign(found_.size(), 0);
-    workers.run(
-        count,
-        [&](std::size_t begin, std::size_t end, int thread) {
-          std::vector<Pair>& found = found_[static_cast<std::size_t>(thread)];
-          std::int64_t& walked = walked_[static_cast<std::size_t>(thread)];
-          for (std::size_t self = begin; self < end; ++self) {
-            const auto first = static_cast<std::uint32_t>(self);
-            query(
-                grid, boxes + self, walked, [&](std::uint32_t other) { return accept(first, other); },
-                [&](std::uint32_t other) {
-                  Pair pair{};
-                  corners(first, other, pair.v);
-                  pair.first = first;
-                  pair.second = other;
-                  pair.edges = edges;
-                  found.push_back(pair);
-                });
-          }
-        },
-        256);
-    for (const std::vector<Pair>& found : found_) pairs_.insert(pairs_.end(), found.begin(), found.end());
-    for (const std::int64_t walked : walked_) stats_.cellsWalked += walked;
-  };
+      },
+      64);
   pairs_.clear();
-  // Vertex-triangle pairs: a vertex against the triangles it is no corner of.
-  list(
-      n, triangleGrid_, 0,
-      [&](std::uint32_t v, std::uint32_t t) {
-        const glm::uvec3 c = triangles_[t];
-        return c[0] != v && c[1] != v && c[2] != v;
-      },
-      [&](std::uint32_t v, std::uint32_t t, std::uint32_t* corners) {
-        corners[0] = v;
-        for (int k = 0; k < 3; ++k) corners[k + 1] = triangles_[t][k];
-      },
-      false);
-  // Edge-edge pairs: each pair from its lower edge, of edges that share no end.
-  list(
-      ne, edgeGrid_, n + nt,
-      [&](std::uint32_t e, std::uint32_t f) {
-        const glm::uvec2 a = edges_[e], b = edges_[f];
-        return f > e && a[0] != b[0] && a[0] != b[1] && a[1] != b[0] && a[1] != b[1];
-      },
-      [&](std::uint32_t e, std::uint32_t f, std::uint32_t* corners) {
-        corners[0] = edges_[e][0];
-        corners[1] = edges_[e][1];
-        corners[2] = edges_[f][0];
-        corners[3] = edges_[f][1];
-      },
-      true);
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (std::size_t t = 0; t < threads; ++t) pairs_.insert(pairs_.end(), found_[2 * t + k].begin(), found_[2 * t + k].end());
+  }
+  for (const std::int64_t compared : boxTests_) tests += compared;
+  stats_.boxTests += tests;
+}
+
+bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
+  // Along the line between the two primitives' centres at x0: the hull of one's corners at x0 and
+  // at x against the other's. Apart there, they are apart all along the straight paths from x0 to
+  // x (each corner's path lies between its two ends), by more than `margin`.
+  const std::uint32_t* v = p.v;
+  const Vec3 axis = p.edges ? (x0_[v[0]] + x0_[v[1]]) * 0.5 - (x0_[v[2]] + x0_[v[3]]) * 0.5
+                            : x0_[v[0]] - (x0_[v[1]] + x0_[v[2]] + x0_[v[3]]) * (1.0 / 3.0);
+  const int split = p.edges ? 2 : 1;
+  Real lo[2], hi[2];
+  for (int side = 0; side < 2; ++side) {
+    lo[side] = std::numeric_limits<Real>::max();
+    hi[side] = std::numeric_limits<Real>::lowest();
+  }
+  for (int k = 0; k < 4; ++k) {
+    const int side = k < split ? 0 : 1;
+    const Real a = glm::dot(x0_[v[k]], axis), b = glm::dot(x_[v[k]], axis);
+    lo[side] = std::min({lo[side], a, b});
+    hi[side] = std::max({hi[side], a, b});
+  }
+  // Along the axis as it is (not of unit length): the margin scaled by its length, and room for
+  // the rounding of the dot products, which grows with the coordinates.
+  const Real length = glm::length(axis);
+  const Real scale = std::max({std::abs(lo[0]), std::abs(hi[0]), std::abs(lo[1]), std::abs(hi[1])});
+  const Real room = margin * length + 1e-12 * scale;
+  return length > 0.0 && (hi[1] + room < lo[0] || hi[0] + room < lo[1]);
+}
+
+void SelfContact::measure(Pair& pair) const {
+  const std::uint32_t* v = pair.v;
+  const Weights weights = pair.edges ? edgeEdgeWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]])
+                                     : vertexTriangleWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
+  for (int k = 0; k < 4; ++k) pair.c[k] = weights.c[k];
+  const Vec3 gap = between(weights, x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
+  pair.gap0 = glm::length(gap);
+  pair.normal = pair.gap0 > kCoincident ? gap / pair.gap0 : Vec3{0.0};
+  pair.far = false;
 }
 
 void SelfContact::measurePairs(Real distance, Workers& workers) {
-  // Each pair's closest points at x0, the direction between them, and how far apart they keep.
+  // Each pair's closest points at x0, the direction between them, and how far apart they keep;
+  // except a pair apart by more than `distance` all through the substep (as the solve found it),
+  // which no sweep pushes: it is marked far, and the fail-safe looks at it again at its end.
   workers.run(
       pairs_.size(),
       [&](std::size_t begin, std::size_t end, int) {
         for (std::size_t i = begin; i < end; ++i) {
           Pair& pair = pairs_[i];
-          const std::uint32_t* v = pair.v;
-          const bool same = clothOf_[v[0]] == clothOf_[v[2]];
-          Weights weights, restWeights{};
-          if (pair.edges) {
-            weights = edgeEdgeWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
-            if (same) restWeights = edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
-          } else {
-            weights = vertexTriangleWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
-            if (same) restWeights = vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
-          }
-          for (int k = 0; k < 4; ++k) pair.c[k] = weights.c[k];
-          const Vec3 gap = between(weights, x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
-          pair.gap0 = glm::length(gap);
-          pair.normal = pair.gap0 > kCoincident ? gap / pair.gap0 : Vec3{0.0};
-          pair.target = distance;
-          if (same) {
-            // Parts of one cloth closer than `distance` at rest keep their rest distance.
-            pair.target = std::min(
-                distance, glm::length(between(restWeights, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])));
-          }
           pair.push = 0.0;
+          if (apartAlongCentres(pair, distance)) {
+            pair.far = true;
+          } else {
+            measure(pair);
+          }
         }
       },
       1024);
@@ -539,7 +634,7 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
   active_.clear();
   for (std::uint32_t i = 0; i < pairs_.size(); ++i) {
     const Pair& p = pairs_[i];
-    if (p.gap0 > kCoincident && gapNow(p) < distance) active_.push_back(i);
+    if (!p.far && p.gap0 > kCoincident && gapNow(p) < distance) active_.push_back(i);
   }
   const std::vector<std::uint32_t>& active = active_;
   for (int sweep = 0; sweep < kSweeps; ++sweep) {
@@ -675,7 +770,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
   // Every round but the last joins two zones or more: at most one round a particle.
   for (std::uint32_t round = 1;; ++round) {
     tests.clear();
-    for (const Pair& p : pairs_) {
+    for (Pair& p : pairs_) {
       if (round > 1) {
         // After the first round, only pairs whose tests a zone's move changed.
         bool moved = false;
@@ -690,6 +785,12 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
           const Vec3 d = (x_[p.v[i]] - x0_[p.v[i]]) - (x_[p.v[j]] - x0_[p.v[j]]);
           m = std::max(m, glm::dot(d, d));
         }
+      }
+      if (p.far) {
+        // Far when the solve began: still apart along the line between their centres, or looked
+        // at as any other pair.
+        if (apartAlongCentres(p, kProofMargin)) continue;
+        measure(p);
       }
       if (p.gap0 > std::sqrt(m) + kProofMargin) continue;  // proven apart all the way
       ++stats_.tested;

@@ -4,8 +4,9 @@
 //
 // 1. Broad phase. Each particle's motion over the substep (from x0, where the substep started, to
 //    x, where the sweeps left it) is boxed, the box grown by `distance`; a triangle's and an edge's
-//    box holds its corners' boxes. A hashed grid pairs every particle with the triangles and every
-//    edge with the edges whose boxes its own overlaps (not those it is a corner or end of).
+//    box holds its corners' boxes. A tree of boxes over the mesh (fitted again each search, built
+//    with the mesh) pairs every particle with the triangles and every edge with the edges whose
+//    boxes its own overlaps (not those it is a corner or end of).
 // 2. Contacts. For each pair, the closest points at x0 (barycentric on the triangle, or along the
 //    two edges) and the direction between them, n. The contact keeps the two points at least the
 //    target apart along n: `distance`, or less for parts of one cloth closer than that at rest. It
@@ -26,8 +27,9 @@
 //    ends; in the worst case everything moves as one body.
 //
 // A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
-// it would without self-contact. Deterministic whatever the number of threads: the pairs are listed
-// in parallel, each thread its run of particles and edges, joined in that order, and solved in it.
+// it would without self-contact. Deterministic whatever the number of threads: the tree's walk lists
+// the overlapping leaves in one order, their pairs are listed in parallel, each thread its run of
+// them, joined in that order, and solved in it.
 #pragma once
 
 #include <cstdint>
@@ -64,14 +66,21 @@ class SelfContact {
     Real push;                    // correction along the normal this substep, m (for friction)
     std::uint32_t first, second;  // vertex and triangle, or the two edges
     bool edges;
+    bool far;  // apart by more than the distance as the solve began: c, normal and gap0 not made
   };
+  // The pairs of the last substep, in the order they are solved (for tests).
+  const std::vector<Pair>& pairs() const { return pairs_; }
 
  private:
   void buildMesh(const std::vector<Cloth>& cloths);
+  void buildTree();
+  void fitTree();
   void gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>& scratch);
   void scatter(std::vector<Cloth>& cloths) const;
   void findPairs(Real distance, Real ahead, Workers& workers);
   void measurePairs(Real distance, Workers& workers);
+  void measure(Pair& pair) const;
+  bool apartAlongCentres(const Pair& pair, Real margin) const;
   void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
   void failSafe(Real distance, Workers& workers);
   bool withinBoxes(Real margin) const;
@@ -100,22 +109,27 @@ class SelfContact {
   std::vector<Plane> planes_;                   // the collider contacts of this substep
   std::vector<Vec3> lower_, upper_;             // boxes of the particles, triangles, edges: in that order
   std::vector<glm::vec3> boxLower_, boxUpper_;  // the same in single precision, rounded outwards
-  struct Entry {
-    std::uint64_t cell;  // its cell's three coordinates, packed
-    std::uint32_t index;
-    std::uint8_t starts;     // bit k: its box starts in this cell along axis k
-    glm::vec3 lower, upper;  // its box, rounded outwards
+  // The broad phase's tree (a bounding-volume hierarchy), built with the mesh from the rest shape:
+  // cloth by cloth, then halving the triangles at the median along the longest side of their rest
+  // centroids, down to leaves of at most kLeafTriangles. Every primitive belongs to one leaf: a
+  // triangle to its own, a vertex and an edge to the leaf of their first triangle (a particle in
+  // no triangle, as a chain's, to a leaf of its own). A search fits each leaf's box around what it
+  // holds and each node's around its children, then walks the tree against itself for the pairs
+  // of leaves whose boxes overlap, and tests their primitives: each pair of primitives whose boxes
+  // overlap is then found exactly once, in the pair of leaves that hold them.
+  struct Node {
+    glm::vec3 lower, upper;
+    std::uint32_t left, right;  // children; a leaf: right is kNone and left its leaf
   };
-  struct Grid {
-    std::vector<std::uint32_t> start;
-    std::vector<Entry> entries;
-    // The cells its boxes cover lie within these: a query walks only the part of its own cells
-    // inside them (a particle flung 1e13 m has a box of millions of cells, almost all empty).
-    glm::i64vec3 lowest{0}, highest{-1};
-  } triangleGrid_, edgeGrid_;
-  Real cellSize_ = 1.0;
-  std::vector<std::vector<Pair>> found_;  // per thread
-  std::vector<std::int64_t> walked_;      // per thread: grid cells its queries looked in
+  std::vector<Node> nodes_;  // parents before children
+  std::vector<std::uint32_t> leafTriangleStart_, leafTriangles_;  // per leaf, its triangles
+  std::vector<std::uint32_t> leafVertexStart_, leafVertices_;    // ... its vertices
+  std::vector<std::uint32_t> leafEdgeStart_, leafEdges_;         // ... its edges
+  std::vector<std::uint32_t> leafNode_;                          // per leaf, its node
+  std::vector<std::uint64_t> leafPairs_;  // this search's overlapping leaves (lower in the high word)
+  std::vector<std::uint64_t> stack_;      // the walk's node pairs still to look at
+  std::vector<std::vector<Pair>> found_;  // per thread: vertex-triangle pairs, then edge-edge pairs
+  std::vector<std::int64_t> boxTests_;    // per thread: primitive boxes compared
   std::vector<Pair> pairs_;
   std::vector<std::uint32_t> active_;  // pairs the sweeps look at
   // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is

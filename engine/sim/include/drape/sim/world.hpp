@@ -68,7 +68,7 @@ struct SelfContactStats {
   std::int64_t fallbacks = 0;      // since made: substeps whose zones went back to where they began
   std::int64_t searches = 0;       // since made: broad-phase searches (the pairs found anew)
   std::int64_t triangleTests = 0;  // since made: exact triangle-triangle tests by the fail-safe
-  std::int64_t cellsWalked = 0;    // since made: grid cells the broad phase's queries looked in
+  std::int64_t boxTests = 0;       // since made: boxes the broad phase compared (its tree's nodes and primitives)
 };
 
 class Workers;
