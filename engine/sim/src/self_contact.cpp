@@ -909,20 +909,46 @@ void SelfContact::scatter(std::vector<Cloth>& cloths) const {
   }
 }
 
-void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
-                        const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
-                        Workers& workers) {
+bool SelfContact::prepare(const std::vector<Cloth>& cloths, std::uint64_t topologyVersion) {
   std::size_t n = 0, nt = 0;
   for (const Cloth& cloth : cloths) {
     n += cloth.state.position.size();
     nt += cloth.rest.triangles.size();
   }
-  bool fresh = false;
-  if (topologyVersion != meshVersion_ || n != meshParticles_ || nt != triangles_.size()) {
-    buildMesh(cloths);
-    meshVersion_ = topologyVersion;
-    fresh = true;
+  if (topologyVersion == meshVersion_ && n == meshParticles_ && nt == triangles_.size()) return false;
+  buildMesh(cloths);
+  meshVersion_ = topologyVersion;
+  return true;
+}
+
+void SelfContact::settle(std::vector<Cloth>& cloths, const std::vector<std::vector<Vec3>>& before,
+                         const SelfCollisionSettings& settings, std::uint64_t topologyVersion, Workers& workers) {
+  prepare(cloths, topologyVersion);
+  const std::size_t n = clothOf_.size();
+  x0_.resize(n);
+  x_.resize(n);
+  w_.resize(n);
+  planes_.clear();
+  std::size_t k = 0;
+  for (std::size_t c = 0; c < cloths.size(); ++c) {
+    const ParticleState& s = cloths[c].state;
+    for (std::size_t i = 0; i < s.position.size(); ++i, ++k) {
+      x0_[k] = before[c][i];
+      x_[k] = s.position[i];
+      w_[k] = s.inverseMass[i];
+    }
   }
+  findPairs(settings.distance, 1.0, workers);
+  measurePairs(settings.distance, workers);
+  failSafe(settings.distance, workers);
+  scatter(cloths);
+  distance_ = -1.0;  // the pairs were for this move: the next substep finds its own
+}
+
+void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
+                        const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
+                        Workers& workers) {
+  const bool fresh = prepare(cloths, topologyVersion);
   gather(cloths, scratch);
   // The pairs found at a substep serve the rest of its step while every particle, at x0 and now,
   // keeps half a `distance` inside its box: two primitives within `distance` of each other are then

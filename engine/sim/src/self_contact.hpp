@@ -54,6 +54,11 @@ class SelfContact {
   void solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch, const SelfCollisionSettings& settings,
              std::uint64_t topologyVersion, int substepsLeft, Workers& workers);
   void finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers);
+  // Keeps a move made outside the substeps (a tear's relaxation, a cut putting particles on its
+  // line) from passing cloth through cloth: the fail-safe alone, from `before` (per cloth, where each
+  // particle was) to where the particles are, as if a substep had moved them so.
+  void settle(std::vector<Cloth>& cloths, const std::vector<std::vector<Vec3>>& before,
+              const SelfCollisionSettings& settings, std::uint64_t topologyVersion, Workers& workers);
   const SelfContactStats& stats() const { return stats_; }
   std::size_t bytes() const;
 
@@ -72,6 +77,8 @@ class SelfContact {
   const std::vector<Pair>& pairs() const { return pairs_; }
 
  private:
+  // Makes the mesh again if the topology changed; true if it did.
+  bool prepare(const std::vector<Cloth>& cloths, std::uint64_t topologyVersion);
   void buildMesh(const std::vector<Cloth>& cloths);
   void buildTree();
   void fitTree();

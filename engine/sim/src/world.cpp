@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -930,20 +931,32 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
 }
 
 void World::tear() {
-  std::vector<ParticleSplit> splits;
-  std::vector<ParticleInsert> inserted;
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    splits.clear();
-    inserted.clear();
-    const std::size_t budget =
-        static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
-    if (!topology::tear(cloths_[c], settings_.tearing.threshold, budget, splits, inserted)) continue;
-    afterTopologyChange(c, splits, inserted);
-  }
+  changeTopology([&](Cloth& cloth, std::size_t budget, std::vector<ParticleSplit>& splits,
+                     std::vector<ParticleInsert>& inserted) {
+    return topology::tear(cloth, settings_.tearing.threshold, budget, splits, inserted);
+  });
 }
 
 int World::cut(Vec3 a, Vec3 b, Vec3 depth) {
   if (!finite(a) || !finite(b) || !finite(depth)) return 0;
+  return changeTopology([&](Cloth& cloth, std::size_t budget, std::vector<ParticleSplit>& splits,
+                            std::vector<ParticleInsert>& inserted) {
+    return topology::cut(cloth, a, b, depth, budget, splits, inserted);
+  });
+}
+
+int World::changeTopology(const std::function<bool(Cloth&, std::size_t, std::vector<ParticleSplit>&,
+                                                   std::vector<ParticleInsert>&)>& change) {
+  // A tear relaxes the links near a fresh crack and a cut puts particles near its line onto it:
+  // moves made outside the substeps, where self-contact did not look. With self-contact on, its
+  // fail-safe then takes them as a substep's motion from where each particle was: an old one where
+  // it was, a new one where it was made (on its edge, in the surface as it was), a copy where its
+  // particle was. So neither passes cloth through cloth (a tear's opening seam did, for a few steps).
+  const bool settle = hasStage(Stage::selfContact);
+  std::vector<std::vector<Vec3>> before;
+  if (settle) {
+    for (const Cloth& cloth : cloths_) before.push_back(cloth.state.position);
+  }
   int opened = 0;
   std::vector<ParticleSplit> splits;
   std::vector<ParticleInsert> inserted;
@@ -952,9 +965,36 @@ int World::cut(Vec3 a, Vec3 b, Vec3 depth) {
     inserted.clear();
     const std::size_t budget =
         static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
-    if (!topology::cut(cloths_[c], a, b, depth, budget, splits, inserted)) continue;
+    if (!change(cloths_[c], budget, splits, inserted)) continue;
     afterTopologyChange(c, splits, inserted);
     ++opened;
+    if (!settle) continue;
+    // New particles in the order they were made: each from particles made before it.
+    std::vector<Vec3>& from = before[c];
+    const std::size_t n0 = from.size(), n = cloths_[c].state.position.size();
+    std::vector<std::int64_t> origin(n - n0, -1);  // index into inserted, or -2 - the copy's original
+    for (std::size_t k = 0; k < inserted.size(); ++k) {
+      if (inserted[k].particle >= n0) origin[inserted[k].particle - n0] = static_cast<std::int64_t>(k);
+    }
+    for (const ParticleSplit& split : splits) {
+      if (split.copy >= n0) origin[split.copy - n0] = -2 - static_cast<std::int64_t>(split.original);
+    }
+    from.resize(n);
+    for (std::size_t p = n0; p < n; ++p) {
+      const std::int64_t o = origin[p - n0];
+      if (o >= 0) {
+        const ParticleInsert& in = inserted[static_cast<std::size_t>(o)];
+        from[p] = glm::mix(from[in.a], from[in.b], in.s);
+      } else if (o <= -2) {
+        from[p] = from[static_cast<std::size_t>(-2 - o)];
+      } else {
+        from[p] = cloths_[c].state.position[p];
+      }
+    }
+  }
+  if (settle && opened > 0) {
+    if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
+    selfContact_->settle(cloths_, before, settings_.selfCollision, topologyVersion_, *workers_);
   }
   return opened;
 }

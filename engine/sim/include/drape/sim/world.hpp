@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -213,6 +214,10 @@ class World {
                            const std::vector<ParticleInsert>& inserted = {});
   void moveFingers(Real h);
   void tear();
+  // Runs `change` (a tear or a cut) on every cloth, and what follows a cloth's change; the cloths
+  // it changed.
+  int changeTopology(const std::function<bool(Cloth&, std::size_t, std::vector<ParticleSplit>&,
+                                              std::vector<ParticleInsert>&)>& change);
   void grab(Finger& finger, std::size_t cloth, ParticleIndex nearest);
   std::size_t particleCount() const;
   void runStage(Stage stage);
