@@ -23,26 +23,12 @@ namespace {
 using sim::Real;
 using sim::Vec3;
 
+using test::centroid;
+using test::highest;
 using test::kAssets;
+using test::lowest;
 using test::Played;
-
-Vec3 centroid(const sim::Cloth& cloth) {
-  Vec3 sum{0.0};
-  for (const Vec3& x : cloth.state.position) sum += x;
-  return sum / static_cast<Real>(cloth.state.position.size());
-}
-
-Real highest(const sim::Cloth& cloth) {
-  Real y = -1e9;
-  for (const Vec3& x : cloth.state.position) y = std::max(y, x.y);
-  return y;
-}
-
-Real lowest(const sim::Cloth& cloth) {
-  Real y = 1e9;
-  for (const Vec3& x : cloth.state.position) y = std::min(y, x.y);
-  return y;
-}
+using test::spread;
 
 // Area of the cloth's footprint on the table: its x-z bounding box.
 Real footprint(const sim::Cloth& cloth) {
@@ -52,15 +38,6 @@ Real footprint(const sim::Cloth& cloth) {
     hi = glm::max(hi, x);
   }
   return (hi.x - lo.x) * (hi.z - lo.z);
-}
-
-// Root mean square distance of the particles from their middle, across the table (x-z).
-Real spread(const sim::Cloth& cloth) {
-  const Vec3 middle = centroid(cloth);
-  Real sum = 0.0;
-  for (const Vec3& x : cloth.state.position)
-    sum += (x.x - middle.x) * (x.x - middle.x) + (x.z - middle.z) * (x.z - middle.z);
-  return std::sqrt(sum / static_cast<Real>(cloth.state.position.size()));
 }
 
 Real totalMass(const sim::World& world) {

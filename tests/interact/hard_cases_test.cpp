@@ -1,0 +1,132 @@
+// Issue 21's harder self-contact cases (assets/cases/): eight fingers crumpling, folding twice, a
+// full twist (narrow and wide), a fast corner drag, a pinch lifted and lowered, a long strip dropped on the table, ten
+// cloths dropped on each other. Each is played as drape-cli plays it, the intersecting triangle
+// pairs counted every 5 steps, and must keep 0 at each; and each must do what it says to the cloth.
+// Here at the desk's 24 x 24 (the strip and the ten cloths coarser still, so the sanitizer build
+// runs them in seconds); tools/self-contact-cases plays them at 48 x 48 and 96 x 96 and counts every
+// step (docs/self-contact-cases.md).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "drape/sim/metrics.hpp"
+#include "played.hpp"
+
+namespace drape {
+namespace {
+
+using sim::Real;
+using test::highest;
+using test::kAssets;
+using test::lowest;
+using test::Played;
+using test::spread;
+
+constexpr Real kDistance = 0.005;  // the cases' self-contact distance, m
+
+Played deskCase(const std::string& gesture, const std::vector<std::string>& overrides = {}) {
+  return Played(Played::Files{}, kAssets / "scenes" / "desk.json", kAssets / "cases" / (gesture + ".json"), overrides);
+}
+
+TEST(HardCase, EightFingersCrumpleTheClothWithoutPassingItThroughItself) {
+  Played played = deskCase("crumple-eight");
+  const Real before = spread(played.cloth());
+  played.until(1.85);  // just before they let go
+  EXPECT_LT(spread(played.cloth()), 0.6 * before);
+  EXPECT_GT(highest(played.cloth()), 0.03);  // it rose in folds between the fingers
+  played.until();
+  EXPECT_GT(lowest(played.cloth()), 0.0);
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+}
+
+TEST(HardCase, FoldingTwiceLeavesFourLayersOnAQuarterOfTheTable) {
+  Played played = deskCase("fold-twice");
+  played.until();
+  // The near half went over the far half, then the right half over the left: what was a 60 cm
+  // square lies on the quarter x < 0, z < 0, four layers a self-contact distance apart.
+  Real mostX = -1.0, mostZ = -1.0;
+  for (const sim::Vec3& x : played.cloth().state.position) {
+    mostX = std::max(mostX, x.x);
+    mostZ = std::max(mostZ, x.z);
+  }
+  EXPECT_LT(mostX, 0.06);
+  EXPECT_LT(mostZ, 0.06);
+  EXPECT_GT(highest(played.cloth()), 0.005 + 2.5 * kDistance);
+  EXPECT_GT(lowest(played.cloth()), 0.0);
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+}
+
+TEST(HardCase, AFullTwistOfTheLiftedClothNeverPassesItThroughItself) {
+  Played played = deskCase("twist");
+  played.until(3.2);  // the right grip has turned a full turn, 8 cm in
+  EXPECT_GT(lowest(played.cloth()), 0.0);
+  played.until();
+  EXPECT_GT(lowest(played.cloth()), 0.0);
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+}
+
+TEST(HardCase, AWideTwistLoweredOntoTheTableNeverPassesItThroughItself) {
+  // Gripped 40 cm wide and brought 18 cm in while it turns, the cloth is wound tight and most of
+  // its particles are in contact: the dearest case by far (about 15 s in Release, played up to
+  // 4.4 s, past where it failed). It failed there at 3 pairs from step 254, just after the fingers
+  // let go, before the fail-safe found its pairs again where a zone's move left its boxes.
+  Played played = deskCase("twist-wide");
+  played.until(4.4);
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+  // Not checked: that nothing lies under the table. Lowered onto it, the fingers drag impact zones
+  // (which move as the fingers in them do) through it: a particle ends 1.3 cm under it (issue 21).
+}
+
+TEST(HardCase, ACornerDraggedAcrossAt5MetresASecondBunchesTheClothWithoutPassingItThroughItself) {
+  Played played = deskCase("corner-drag");
+  played.until(0.45);  // the corner has crossed (0.8 m in 0.15 s) and is still held
+  // The light cloth is dragged along and bunches up behind the corner, layer over layer.
+  EXPECT_GT(highest(played.cloth()), 0.03);
+  played.until();
+  // Let go, it falls open (the spring-back of a crumple, docs/design.md), on the table.
+  EXPECT_GT(lowest(played.cloth()), 0.0);
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+}
+
+TEST(HardCase, APinchLiftedAndLoweredOntoTheRestLiesOnItWithoutPassingThrough) {
+  Played played = deskCase("pinch-lift-lower");
+  played.until(1.8);
+  EXPECT_GT(highest(played.cloth()), 0.2);
+  played.until();
+  EXPECT_LT(highest(played.cloth()), 0.1);  // lowered and let go
+  EXPECT_GT(lowest(played.cloth()), 0.0);
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+}
+
+TEST(HardCase, ALongStripDroppedOnTheTablePilesWithoutPassingThroughItself) {
+  // 2 m by 10 cm at 4 x 80 (2.5 cm, the desk's spacing at 24 x 24).
+  Played played(Played::Files{}, kAssets / "cases" / "strip.json", {}, {"cloths.0.grid.columns=4", "cloths.0.grid.rows=80"});
+  played.until(played.scene.duration);
+  // It fell 2 m onto itself: it lies piled, far less than its length high, and on the table.
+  EXPECT_LT(highest(played.cloth()), 0.5);
+  EXPECT_GT(lowest(played.cloth()), 0.0);
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+}
+
+TEST(HardCase, TenClothsDroppedOnEachOtherLieInLayers) {
+  std::vector<std::string> coarse;
+  for (int k = 0; k < 10; ++k) {
+    coarse.push_back("cloths." + std::to_string(k) + ".grid.columns=8");
+    coarse.push_back("cloths." + std::to_string(k) + ".grid.rows=8");
+  }
+  Played played(Played::Files{}, kAssets / "cases" / "ten-cloths.json", {}, coarse);
+  played.until(played.scene.duration);
+  // Each landed on those below: the cloth that fell last lies above the one that fell first, and
+  // their middles a layer apart at least.
+  const auto middleHeight = [&](int c) {
+    const sim::Cloth& cloth = played.cloth(c);
+    return cloth.state.position[cloth.state.position.size() / 2].y;
+  };
+  EXPECT_GT(middleHeight(9), middleHeight(0) + kDistance);
+  for (int c = 0; c < 10; ++c) EXPECT_GT(lowest(played.cloth(c)), 0.0) << "cloth " << c;
+  EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
+}
+
+}  // namespace
+}  // namespace drape
