@@ -553,6 +553,15 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     if (tuned.solver.model == sim::Model::position) {
       changed |= ImGui::Checkbox("self-collision", &tuned.selfCollision.enabled);
       tip("cloth never passes through itself or another cloth (docs/self-contact.md)");
+      int method = tuned.selfCollision.method == sim::SelfContactMethod::triangles ? 0 : 1;
+      const char* methods[] = {"triangles", "particles"};
+      if (ImGui::Combo("self method", &method, methods, 2)) {
+        tuned.selfCollision.method = method == 0 ? sim::SelfContactMethod::triangles : sim::SelfContactMethod::particles;
+        changed = true;
+      }
+      tip("triangles: surfaces keep the distance apart, and an exact fail-safe keeps any step from passing one "
+          "through another; particles: the first wave's method, particles kept apart (cheaper, but a triangle "
+          "passes between particles unless the distance is about the particle spacing)");
       changed |= sliderReal("self distance (m)", tuned.selfCollision.distance, 0.001, 0.1);
       tip("how far apart two layers of cloth are kept");
     }
@@ -615,6 +624,14 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
           "Pairs of triangles passing through each other (cloth through cloth), counted exactly every %d "
           "frames; 0 when no cloth passes through itself or another",
           PanelState::kIntersectionFrames);
+    }
+    if (world.hasStage(sim::Stage::selfContact)) {
+      const sim::SelfContactStats contact = world.selfContactStats();
+      ImGui::Text("self-contact pairs %lld   pushed %lld   zoned %lld", static_cast<long long>(contact.pairs),
+                  static_cast<long long>(contact.pushed), static_cast<long long>(contact.zoned));
+      tip("of the last substep: the vertex-triangle and edge-edge pairs near enough to meet, and those the "
+          "contacts pushed apart; since the start: particles the fail-safe moved as one body with others "
+          "to keep a step from passing cloth through cloth (docs/self-contact.md)");
     }
     const ImVec2 plot(0.0f, 40.0f);
     char overlay[64];
