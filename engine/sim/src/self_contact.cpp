@@ -303,7 +303,8 @@ void SelfContact::fitTree() {
   }
 }
 
-void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>& scratch) {
+void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>* scratch,
+                         const std::vector<std::vector<Vec3>>* before) {
   const std::size_t n = clothOf_.size();
   x0_.resize(n);
   x_.resize(n);
@@ -312,13 +313,14 @@ void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<Sol
   std::size_t k = 0;
   for (std::size_t c = 0; c < cloths.size(); ++c) {
     const ParticleState& s = cloths[c].state;
-    const SolverScratch& contacts = scratch[c];
-    const bool planes = contacts.contactCollider.size() == s.position.size();
+    const bool planes = scratch && (*scratch)[c].contactCollider.size() == s.position.size();
     for (std::size_t i = 0; i < s.position.size(); ++i, ++k) {
-      x0_[k] = s.previousPosition[i];  // where the substep began: the integration left it there
+      // Where the substep began (the integration left it there), or where the move began.
+      x0_[k] = before ? (*before)[c][i] : s.previousPosition[i];
       x_[k] = s.position[i];
       w_[k] = s.inverseMass[i];
-      if (planes && contacts.contactCollider[i] >= 0) {
+      if (planes && (*scratch)[c].contactCollider[i] >= 0) {
+        const SolverScratch& contacts = (*scratch)[c];
         planes_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(i),
                            contacts.contactNormal[i], contacts.contactOffset[i]});
       }
@@ -940,20 +942,7 @@ bool SelfContact::prepare(const std::vector<Cloth>& cloths, std::uint64_t topolo
 void SelfContact::settle(std::vector<Cloth>& cloths, const std::vector<std::vector<Vec3>>& before,
                          const SelfCollisionSettings& settings, std::uint64_t topologyVersion, Workers& workers) {
   prepare(cloths, topologyVersion);
-  const std::size_t n = clothOf_.size();
-  x0_.resize(n);
-  x_.resize(n);
-  w_.resize(n);
-  planes_.clear();
-  std::size_t k = 0;
-  for (std::size_t c = 0; c < cloths.size(); ++c) {
-    const ParticleState& s = cloths[c].state;
-    for (std::size_t i = 0; i < s.position.size(); ++i, ++k) {
-      x0_[k] = before[c][i];
-      x_[k] = s.position[i];
-      w_[k] = s.inverseMass[i];
-    }
-  }
+  gather(cloths, nullptr, &before);
   findPairs(settings.distance, 1.0, workers);
   measurePairs(settings.distance, workers);
   failSafe(settings.distance, workers);
@@ -965,7 +954,7 @@ void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& 
                         const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
                         Workers& workers) {
   const bool fresh = prepare(cloths, topologyVersion);
-  gather(cloths, scratch);
+  gather(cloths, &scratch, nullptr);
   // The pairs found at a substep serve the rest of its step while every particle, at x0 and now,
   // keeps half a `distance` inside its box: two primitives within `distance` of each other are then
   // still among them.

@@ -82,7 +82,10 @@ class SelfContact {
   void buildMesh(const std::vector<Cloth>& cloths);
   void buildTree();
   void fitTree();
-  void gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>& scratch);
+  // Positions and inverse masses into the world's numbering; x0 from `before` if given (settle),
+  // else each particle's previous position, and the collider contacts from `scratch` if given.
+  void gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>* scratch,
+              const std::vector<std::vector<Vec3>>* before);
   void scatter(std::vector<Cloth>& cloths) const;
   void findPairs(Real distance, Real ahead, Workers& workers);
   void measurePairs(Real distance, Workers& workers);
