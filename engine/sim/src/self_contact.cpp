@@ -113,13 +113,19 @@ Vec3 between(const Weights& w, const Vec3& p0, const Vec3& p1, const Vec3& p2, c
 }
 
 // A box in single precision, grown to hold the double one.
+// (Clamped to the float range first: a torn primitive's empty box is +-DBL_MAX, which no float
+// holds, and converting it would be undefined. A NaN stays NaN.)
+float toFloat(Real v) {
+  constexpr Real most = std::numeric_limits<float>::max();
+  return static_cast<float>(v < -most ? -most : v > most ? most : v);
+}
 glm::vec3 below(const Vec3& x) {
-  return {std::nextafter(static_cast<float>(x.x), -INFINITY), std::nextafter(static_cast<float>(x.y), -INFINITY),
-          std::nextafter(static_cast<float>(x.z), -INFINITY)};
+  return {std::nextafter(toFloat(x.x), -INFINITY), std::nextafter(toFloat(x.y), -INFINITY),
+          std::nextafter(toFloat(x.z), -INFINITY)};
 }
 glm::vec3 above(const Vec3& x) {
-  return {std::nextafter(static_cast<float>(x.x), INFINITY), std::nextafter(static_cast<float>(x.y), INFINITY),
-          std::nextafter(static_cast<float>(x.z), INFINITY)};
+  return {std::nextafter(toFloat(x.x), INFINITY), std::nextafter(toFloat(x.y), INFINITY),
+          std::nextafter(toFloat(x.z), INFINITY)};
 }
 
 bool overlap(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& otherLo, const glm::vec3& otherHi) {
@@ -427,8 +433,8 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     }
   }
 
-  // Whether the two primitives' boxes lie apart along `axis` (a triangle's normal, or across two
-  // edges): the hull of the first `split` corners' boxes and that of the rest. Boxes that overlap
+  // Whether the two primitives' boxes lie apart along `axis` (the line between their centres): the
+  // hull of the first `split` corners' boxes and that of the rest. Boxes that overlap
   // may still: a vertex's box inside a tilted triangle's box, a layer above it. Then, as for boxes
   // that do not overlap, while every particle keeps half a `distance` inside its box the two stay
   // at least `distance` apart (each hull shrinks by half a distance along the axis); so the pair is
@@ -448,9 +454,12 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
       const int side = k < split ? 0 : 1;
       lo[side] = std::min(lo[side], at - half);
       hi[side] = std::max(hi[side], at + half);
-      scale = std::max({scale, std::abs(at), half});
+      // The dot products' rounding grows with the coordinates themselves, not with the projection.
+      scale = std::max(scale, glm::dot(glm::abs(centre), size) + half);
     }
     const Real margin = 1e-9 + 1e-12 * scale;
+    // Not apart unless every figure is finite (min and max pass a NaN by).
+    if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + margin)) return false;
     return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
   };
 
@@ -560,8 +569,13 @@ bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
   // Along the axis as it is (not of unit length): the margin scaled by its length, and room for
   // the rounding of the dot products, which grows with the coordinates.
   const Real length = glm::length(axis);
-  const Real scale = std::max({std::abs(lo[0]), std::abs(hi[0]), std::abs(lo[1]), std::abs(hi[1])});
+  Real scale = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    scale = std::max({scale, glm::dot(glm::abs(x0_[v[k]]), glm::abs(axis)), glm::dot(glm::abs(x_[v[k]]), glm::abs(axis))});
+  }
   const Real room = margin * length + 1e-12 * scale;
+  // Not apart unless every figure is finite (min and max pass a NaN by).
+  if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + room)) return false;
   return length > 0.0 && (hi[1] + room < lo[0] || hi[0] + room < lo[1]);
 }
 

@@ -6,13 +6,16 @@
 //    x, where the sweeps left it) is boxed, the box grown by `distance`; a triangle's and an edge's
 //    box holds its corners' boxes. A tree of boxes over the mesh (fitted again each search, built
 //    with the mesh) pairs every particle with the triangles and every edge with the edges whose
-//    boxes its own overlaps (not those it is a corner or end of).
+//    boxes its own overlaps (not those it is a corner or end of), but not a pair whose boxes lie
+//    apart along the line between the two primitives' centres.
 // 2. Contacts. For each pair, the closest points at x0 (barycentric on the triangle, or along the
 //    two edges) and the direction between them, n. The contact keeps the two points at least the
 //    target apart along n: `distance`, or less for parts of one cloth closer than that at rest. It
 //    is linear in the positions, C(x) = sum_k c_k (n . x_k) - target >= 0 with sum_k c_k = 0, and
 //    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding), except
-//    where that would move a particle far more than the points part (kLeverage). Then
+//    where that would move a particle far more than the points part (kLeverage). A pair whose
+//    corners lie more than `distance` apart along the line between its centres all through the
+//    substep is far: not measured, not pushed (the fail-safe proves it apart by that line). Then
 //    Coulomb friction in position form on each pair that was pushed: the tangential part of its
 //    relative motion, removed up to `friction` times the push.
 // 3. Fail-safe. Along the straight path from x0 to x, two primitives at x0-distance g can only
@@ -24,7 +27,8 @@
 //    (as it was at x0, so intersection-free, and with its momentum). Held and pinned corners join
 //    only where a zone of free ones still passes through them (then they count as infinitely heavy
 //    and the grip slips for the substep). Then again, until no pair changes: zones only grow, so it
-//    ends; in the worst case everything moves as one body.
+//    ends; in the worst case everything moves as one body. Where a zone's move takes a member out
+//    of its box, the pairs are found again first.
 //
 // A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
 // it would without self-contact. Deterministic whatever the number of threads: the tree's walk lists
@@ -73,7 +77,8 @@ class SelfContact {
     bool edges;
     bool far;  // apart by more than the distance as the solve began: c, normal and gap0 not made
   };
-  // The pairs of the last substep, in the order they are solved (for tests).
+  // The pairs last found (by a substep's search, its fail-safe's, or settle's), in the order they
+  // are solved (for tests).
   const std::vector<Pair>& pairs() const { return pairs_; }
 
  private:
@@ -121,7 +126,8 @@ class SelfContact {
   std::vector<glm::vec3> boxLower_, boxUpper_;  // the same in single precision, rounded outwards
   // The broad phase's tree (a bounding-volume hierarchy), built with the mesh from the rest shape:
   // cloth by cloth, then halving the triangles at the median along the longest side of their rest
-  // centroids, down to leaves of at most kLeafTriangles. Every primitive belongs to one leaf: a
+  // centroids, down to leaves of at most kLeafTriangles items (triangles, and particles in no
+  // triangle). Every primitive belongs to one leaf: a
   // triangle to its own, a vertex and an edge to the leaf of their first triangle (a particle in
   // no triangle, as a chain's, to a leaf of its own). A search fits each leaf's box around what it
   // holds and each node's around its children, then walks the tree against itself for the pairs

@@ -177,7 +177,7 @@ void sever(Topology& topology, std::uint32_t t, int edge) {
 // About `wanted` kilograms taken from `left` (wanted > 0): the share, with what is left in `left`,
 // the two adding up to what `left` was exactly. Where the share is at least half of left, left -
 // share is exact (Sterbenz); else left - share rounded is at least half of left, and left minus
-// that is exact. A share of all or more of it is cut to half. Neither part is less than 1/64 of
+// that is exact. Neither part is less than 1/64 of
 // what left was: a share of a degenerate triangle's area (nothing, or so little that left minus it
 // rounds back to left) would leave a particle with no mass, its inverse infinite, and the next
 // correction would make it NaN (a fuzzed snapshot with a particle's rest position moved 1 m

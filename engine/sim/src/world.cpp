@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -988,11 +989,14 @@ int World::changeTopology(const std::function<bool(Cloth&, std::size_t, std::vec
       } else if (o <= -2) {
         from[p] = from[static_cast<std::size_t>(-2 - o)];
       } else {
+        assert(false && "every new particle is a split's copy or an insert");
         from[p] = cloths_[c].state.position[p];
       }
     }
   }
   if (settle && opened > 0) {
+    // (A cloth that did not change has as many particles as before.)
+    for (std::size_t c = 0; c < cloths_.size(); ++c) assert(before[c].size() == cloths_[c].state.position.size());
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
     selfContact_->settle(cloths_, before, settings_.selfCollision, topologyVersion_, *workers_);
   }
