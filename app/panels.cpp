@@ -556,7 +556,8 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       int method = tuned.selfCollision.method == sim::SelfContactMethod::triangles ? 0 : 1;
       const char* methods[] = {"triangles", "particles"};
       if (ImGui::Combo("self method", &method, methods, 2)) {
-        tuned.selfCollision.method = method == 0 ? sim::SelfContactMethod::triangles : sim::SelfContactMethod::particles;
+        tuned.selfCollision.method =
+            method == 0 ? sim::SelfContactMethod::triangles : sim::SelfContactMethod::particles;
         changed = true;
       }
       tip("triangles: surfaces keep the distance apart, and an exact fail-safe keeps any step from passing one "

@@ -101,7 +101,8 @@ TEST(HardCase, APinchLiftedAndLoweredOntoTheRestLiesOnItWithoutPassingThrough) {
 
 TEST(HardCase, ALongStripDroppedOnTheTablePilesWithoutPassingThroughItself) {
   // 2 m by 10 cm at 4 x 80 (2.5 cm, the desk's spacing at 24 x 24).
-  Played played(Played::Files{}, kAssets / "cases" / "strip.json", {}, {"cloths.0.grid.columns=4", "cloths.0.grid.rows=80"});
+  Played played(Played::Files{}, kAssets / "cases" / "strip.json", {},
+                {"cloths.0.grid.columns=4", "cloths.0.grid.rows=80"});
   played.until(played.scene.duration);
   // It fell 2 m onto itself: it lies piled, far less than its length high, and on the table.
   EXPECT_LT(highest(played.cloth()), 0.5);

@@ -275,7 +275,8 @@ TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
     contact::SelfContact contact;
     contact.solve(copy, scratch, settings.selfCollision, 1, 1, workers);
     std::vector<std::tuple<bool, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> pairs;
-    for (const contact::SelfContact::Pair& p : contact.pairs()) pairs.emplace_back(p.edges, p.v[0], p.v[1], p.v[2], p.v[3]);
+    for (const contact::SelfContact::Pair& p : contact.pairs())
+      pairs.emplace_back(p.edges, p.v[0], p.v[1], p.v[2], p.v[3]);
     return pairs;
   };
   const auto pairs = listed(1);
@@ -300,11 +301,14 @@ TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
         if (t[0] == v || t[1] == v || t[2] == v) continue;
         if (glm::length(p[v] - p[t[0]]) > 0.2) continue;  // far: no triangle is 15 cm across
         const Real d = nearest(
-            [&](Real a, Real b) { return glm::length(p[v] - (p[t[0]] + (p[t[1]] - p[t[0]]) * a + (p[t[2]] - p[t[0]]) * b)); },
+            [&](Real a, Real b) {
+              return glm::length(p[v] - (p[t[0]] + (p[t[1]] - p[t[0]]) * a + (p[t[2]] - p[t[0]]) * b));
+            },
             12);
         if (d > 0.8 * kDistance) continue;
         ++within;
-        EXPECT_TRUE(found.count({false, v, t[0], t[1], t[2]})) << "vertex " << v << " and a triangle " << d << " m apart";
+        EXPECT_TRUE(found.count({false, v, t[0], t[1], t[2]}))
+            << "vertex " << v << " and a triangle " << d << " m apart";
       }
     }
     for (std::size_t e = 0; e < edges.size(); ++e) {
@@ -316,7 +320,8 @@ TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
         Real best = std::numeric_limits<Real>::max();
         for (int i = 0; i <= 24; ++i) {
           for (int j = 0; j <= 24; ++j) {
-            best = std::min(best, glm::length(p[a0] + (p[a1] - p[a0]) * (i / 24.0) - p[b0] - (p[b1] - p[b0]) * (j / 24.0)));
+            best = std::min(best,
+                            glm::length(p[a0] + (p[a1] - p[a0]) * (i / 24.0) - p[b0] - (p[b1] - p[b0]) * (j / 24.0)));
           }
         }
         if (best > 0.8 * kDistance) continue;

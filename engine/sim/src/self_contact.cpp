@@ -541,7 +541,8 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
       64);
   pairs_.clear();
   for (std::size_t k = 0; k < 2; ++k) {
-    for (std::size_t t = 0; t < threads; ++t) pairs_.insert(pairs_.end(), found_[2 * t + k].begin(), found_[2 * t + k].end());
+    for (std::size_t t = 0; t < threads; ++t)
+      pairs_.insert(pairs_.end(), found_[2 * t + k].begin(), found_[2 * t + k].end());
   }
   for (const std::int64_t compared : boxTests_) tests += compared;
   stats_.boxTests += tests;
@@ -571,7 +572,8 @@ bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
   const Real length = glm::length(axis);
   Real scale = 0.0;
   for (int k = 0; k < 4; ++k) {
-    scale = std::max({scale, glm::dot(glm::abs(x0_[v[k]]), glm::abs(axis)), glm::dot(glm::abs(x_[v[k]]), glm::abs(axis))});
+    scale =
+        std::max({scale, glm::dot(glm::abs(x0_[v[k]]), glm::abs(axis)), glm::dot(glm::abs(x_[v[k]]), glm::abs(axis))});
   }
   const Real room = margin * length + 1e-12 * scale;
   // Not apart unless every figure is finite (min and max pass a NaN by).

@@ -137,11 +137,11 @@ class SelfContact {
     glm::vec3 lower, upper;
     std::uint32_t left, right;  // children; a leaf: right is kNone and left its leaf
   };
-  std::vector<Node> nodes_;  // parents before children
+  std::vector<Node> nodes_;                                       // parents before children
   std::vector<std::uint32_t> leafTriangleStart_, leafTriangles_;  // per leaf, its triangles
-  std::vector<std::uint32_t> leafVertexStart_, leafVertices_;    // ... its vertices
-  std::vector<std::uint32_t> leafEdgeStart_, leafEdges_;         // ... its edges
-  std::vector<std::uint32_t> leafNode_;                          // per leaf, its node
+  std::vector<std::uint32_t> leafVertexStart_, leafVertices_;     // ... its vertices
+  std::vector<std::uint32_t> leafEdgeStart_, leafEdges_;          // ... its edges
+  std::vector<std::uint32_t> leafNode_;                           // per leaf, its node
   std::vector<std::uint64_t> leafPairs_;  // this search's overlapping leaves (lower in the high word)
   std::vector<std::uint64_t> stack_;      // the walk's node pairs still to look at
   std::vector<std::vector<Pair>> found_;  // per thread: vertex-triangle pairs, then edge-edge pairs

@@ -932,22 +932,22 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
 }
 
 void World::tear() {
-  changeTopology([&](Cloth& cloth, std::size_t budget, std::vector<ParticleSplit>& splits,
-                     std::vector<ParticleInsert>& inserted) {
-    return topology::tear(cloth, settings_.tearing.threshold, budget, splits, inserted);
-  });
+  changeTopology(
+      [&](Cloth& cloth, std::size_t budget, std::vector<ParticleSplit>& splits, std::vector<ParticleInsert>& inserted) {
+        return topology::tear(cloth, settings_.tearing.threshold, budget, splits, inserted);
+      });
 }
 
 int World::cut(Vec3 a, Vec3 b, Vec3 depth) {
   if (!finite(a) || !finite(b) || !finite(depth)) return 0;
-  return changeTopology([&](Cloth& cloth, std::size_t budget, std::vector<ParticleSplit>& splits,
-                            std::vector<ParticleInsert>& inserted) {
-    return topology::cut(cloth, a, b, depth, budget, splits, inserted);
-  });
+  return changeTopology(
+      [&](Cloth& cloth, std::size_t budget, std::vector<ParticleSplit>& splits, std::vector<ParticleInsert>& inserted) {
+        return topology::cut(cloth, a, b, depth, budget, splits, inserted);
+      });
 }
 
-int World::changeTopology(const std::function<bool(Cloth&, std::size_t, std::vector<ParticleSplit>&,
-                                                   std::vector<ParticleInsert>&)>& change) {
+int World::changeTopology(
+    const std::function<bool(Cloth&, std::size_t, std::vector<ParticleSplit>&, std::vector<ParticleInsert>&)>& change) {
   // A tear relaxes the links near a fresh crack and a cut puts particles near its line onto it:
   // moves made outside the substeps, where self-contact did not look. With self-contact on, its
   // fail-safe then takes them as a substep's motion from where each particle was: an old one where
