@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -366,7 +367,7 @@ TEST_F(Cli, BenchQuickKeepsWhatIsGivenExplicitly) {
   // --quick stands for N = 16 and 24; given --sizes 20, only 20 is timed.
   const fs::path folder = file("quick");
   const Result result =
-      run("bench --quick --sizes 20 --threads 1 --naive-iterations 0 --scenes '' --quiet --out-dir '" +
+      run("bench --quick --sizes 20 --threads 1 --naive-iterations 0 --scenes '' --touch-sizes 0 --quiet --out-dir '" +
           folder.string() + "'");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   std::istringstream csv(read(folder / "performance.csv"));
@@ -382,8 +383,8 @@ TEST_F(Cli, BenchQuickKeepsWhatIsGivenExplicitly) {
 
 TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
   const fs::path folder = file("performance"), report = file("performance.md");
-  const Result result = run("bench --quick --scenes hang2-tear --quiet --out-dir '" + folder.string() + "' --report '" +
-                            report.string() + "'");
+  const Result result = run("bench --quick --scenes hang2-tear --touch-sizes 0 --quiet --out-dir '" + folder.string() +
+                            "' --report '" + report.string() + "'");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   EXPECT_TRUE(fs::exists(folder / "performance.png"));
   std::istringstream csv(read(folder / "performance.csv"));
@@ -428,12 +429,90 @@ TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
   EXPECT_NE(text.find("verlet integrate"), std::string::npos);  // the stages, by name
 }
 
+TEST_F(Cli, BenchPlaysTheScenesPeopleTouchWholeAndStopsAtItsBudget) {
+  // At 6 x 6 every case plays whole, on one thread and two, and ends where it ends on both; at
+  // 40 x 40 a budget of a millisecond stops each after its first frame, and the self-contact
+  // distance is 0.3 of the spacing where that is under the scene's 5 mm (the desk's 0.6 m / 39).
+  struct Row {
+    std::string name;
+    int n, particles, threads, frames, run, diverged;
+    double distance;
+    unsigned long pairs;
+  };
+  const auto play = [&](const std::string& options, const fs::path& folder, const fs::path& report) {
+    const Result result = run("bench --quick --sizes 16 --naive-iterations 0 --scenes '' " + options +
+                              " --quiet --out-dir '" + folder.string() + "' --report '" + report.string() + "'");
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    std::istringstream csv(read(folder / "touch.csv"));
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line,
+              "case,n,particles,threads,distance,frames,frames_run,ms_per_frame,ms_worst_frame,free_strain_end,"
+              "free_strain_worst,pairs_end,pairs_worst,bytes_per_particle,diverged");
+    std::vector<Row> rows;
+    while (std::getline(csv, line)) {
+      char name[32];
+      Row r{};
+      EXPECT_EQ(std::sscanf(line.c_str(), "%31[^,],%d,%d,%d,%lf,%d,%d,%*f,%*f,%*f,%*f,%*u,%lu,%*f,%d", name, &r.n,
+                            &r.particles, &r.threads, &r.distance, &r.frames, &r.run, &r.pairs, &r.diverged),
+                9)
+          << line;
+      r.name = name;
+      EXPECT_EQ(r.particles, r.n * r.n) << line;
+      EXPECT_EQ(r.diverged, 0) << line;
+      EXPECT_EQ(r.pairs, 0u) << line;  // no case passes cloth through cloth
+      rows.push_back(r);
+    }
+    return rows;
+  };
+
+  const fs::path report = file("touch.md");
+  const std::vector<Row> whole = play("--touch-sizes 6 --touch-budget 600", file("touch"), report);
+  std::set<std::string> cases;
+  for (const Row& r : whole) {
+    cases.insert(r.name);
+    EXPECT_EQ(r.run, r.frames) << r.name;
+    if (r.distance > 0.0) {
+      EXPECT_DOUBLE_EQ(r.distance, 0.005) << r.name;
+    }
+  }
+  EXPECT_EQ(whole.size(), 5u * 2u);
+  EXPECT_EQ(cases, (std::set<std::string>{"desk crumple", "desk fold", "desk tear", "drape-sphere", "table edge"}));
+  const std::string text = read(report);
+  EXPECT_NE(text.find("## The scenes people touch"), std::string::npos);
+  // Its last column: the final positions the same bit for bit on one thread and two.
+  std::istringstream table(text.substr(text.find("| case | N |")));
+  std::string line;
+  int same = 0;
+  for (std::getline(table, line); std::getline(table, line) && !line.empty();) {
+    if (line.rfind("|---", 0) == 0) continue;
+    EXPECT_EQ(line.substr(line.size() - 7), "| yes |") << line;
+    ++same;
+  }
+  EXPECT_EQ(same, 10);
+
+  const fs::path cut = file("cut.md");
+  const std::vector<Row> stopped = play("--touch-sizes 40 --touch-budget 0.001 --threads 1", file("cut"), cut);
+  EXPECT_EQ(stopped.size(), 5u);
+  for (const Row& r : stopped) {
+    EXPECT_EQ(r.run, 1) << r.name;
+    EXPECT_GT(r.frames, 1) << r.name;
+    if (r.distance > 0.0) {
+      const double width = r.name == "drape-sphere" ? 1.2 : 0.6;  // the desk's cloth: 60 cm
+      EXPECT_NEAR(r.distance, std::min(0.005, 0.3 * width / 39.0), 1e-11) << r.name;
+    }
+  }
+  EXPECT_NE(read(cut).find("| desk crumple | 40 | 1600 | 4.62 mm | 1 | 1 of 180 |"), std::string::npos);
+}
+
 TEST_F(Cli, BenchRefusesBadValuesWithOneLine) {
   expectOneLineError(run("bench --quick --scenes no-such-scene --out-dir '" + file("p").string() + "'"), 2,
                      "no-such-scene");
   expectOneLineError(run("bench --sizes 1"), 2, "--sizes");
   expectOneLineError(run("bench --threads 0"), 2, "--threads");
   expectOneLineError(run("bench --extra-line-steps 101"), 2, "--extra-line-steps");
+  expectOneLineError(run("bench --touch-sizes 1"), 2, "--touch-sizes");
+  expectOneLineError(run("bench --touch-budget 0"), 2, "--touch-budget");
   EXPECT_FALSE(fs::exists(file("p")));
 }
 

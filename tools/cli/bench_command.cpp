@@ -15,6 +15,7 @@
 #include "build_info.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "touch_bench.hpp"
 #include "drape/bench/hang2.hpp"
 #include "drape/bench/measure.hpp"
 #include "drape/scene/error.hpp"
@@ -117,13 +118,18 @@ int bench(const BenchArguments& input) {
   try {
     BenchArguments arguments = input;
     std::erase(arguments.naiveIterations, 0);  // 0: no baseline
+    std::erase(arguments.touchSizes, 0);       // 0: no touch cases
     // Smallest first, each once: the report compares the first size with the last.
-    for (std::vector<int>* list : {&arguments.sizes, &arguments.threads, &arguments.naiveIterations}) {
+    for (std::vector<int>* list :
+         {&arguments.sizes, &arguments.threads, &arguments.naiveIterations, &arguments.touchSizes}) {
       std::sort(list->begin(), list->end());
       list->erase(std::unique(list->begin(), list->end()), list->end());
     }
     for (int n : arguments.sizes) {
       if (n < 2 || n > 1024) throw scene::InputError("--sizes: " + std::to_string(n) + " is not between 2 and 1024");
+    }
+    for (int n : arguments.touchSizes) {
+      if (n < 2) throw scene::InputError("--touch-sizes: " + std::to_string(n) + " is not 0 or between 2 and 1024");
     }
     // Every scene is read before anything runs: a bad name fails at once.
     std::vector<scene::Scene> scenes;
@@ -187,6 +193,19 @@ int bench(const BenchArguments& input) {
         rows.push_back(
             {scenes[k].name, 0, bench::measureWorld(scenes[k].world, arguments.frames, t, arguments.repeats)});
         progress(rows.back());
+      }
+    }
+    // The scenes people touch, smallest first: one run each (touch_bench.hpp).
+    std::vector<TouchRow> touched;
+    for (int n : arguments.touchSizes) {
+      for (const TouchCase& c : touchCases()) {
+        for (int t : arguments.threads) {
+          touched.push_back(playTouchCase(c, n, t, arguments.touchBudget));
+          if (!arguments.quiet) {
+            std::printf("%s\n", touchLine(touched.back()).c_str());
+            std::fflush(stdout);
+          }
+        }
       }
     }
 
@@ -414,6 +433,7 @@ int bench(const BenchArguments& input) {
       report << " total " << format("%.1f", static_cast<double>(row.m.bytes) / static_cast<double>(row.m.particles))
              << ".\n";
     }
+    if (!touched.empty()) report << "\n" << touchSection(touched, arguments.touchBudget);
     report << "\nPeak resident memory of the whole benchmark process: " << format("%.0f", peakMiB) << " MiB.\n";
 
     std::error_code error;
@@ -422,7 +442,8 @@ int bench(const BenchArguments& input) {
     scene::writeFilesAtomically(
         {{directory / "performance.csv", csv.str()},
          {directory / "performance.dat", plotData(rows, arguments.threads, arguments.naiveIterations)},
-         {directory / "performance.gp", plotScript(arguments.threads, arguments.naiveIterations)}});
+         {directory / "performance.gp", plotScript(arguments.threads, arguments.naiveIterations)},
+         {directory / "touch.csv", touchCsv(touched)}});
     drawWithGnuplot(directory, "performance.gp", "performance.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {

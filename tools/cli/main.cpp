@@ -165,6 +165,17 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000));
   benchCommand->add_option("--scenes", benchArguments.scenes, "More scenes to time (default drape-sphere,hang2-tear)")
       ->delimiter(',');
+  benchCommand
+      ->add_option("--touch-sizes", benchArguments.touchSizes,
+                   "The scenes people touch (desk crumple, fold and tear, drape-sphere, table edge) at N x N, "
+                   "comma-separated (default 64,128,256; 0: none)")
+      ->delimiter(',')
+      ->transform(kDecimal)
+      ->check(CLI::Range(0, 1024));
+  benchCommand
+      ->add_option("--touch-budget", benchArguments.touchBudget,
+                   "Seconds of stepping a touch case may take; it stops there and says how far it got (default 120)")
+      ->check(CLI::Range(0.001, 1.0e6));
   benchCommand->add_option("--frames", benchArguments.frames, "Frames per run (default 120)")
       ->transform(kDecimal)
       ->check(CLI::Range(1, 100000));
@@ -189,7 +200,7 @@ int main(int argc, char** argv) {
       ->transform(kDecimal)
       ->check(CLI::Range(0, 100));
   benchCommand->add_flag("--quick", benchArguments.quick,
-                         "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps (each unless given)");
+                         "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps, touch cases at 8 x 8 for 2 s (each unless given)");
   addReportOptions(benchCommand, benchArguments.outDir, benchArguments.report, benchArguments.quiet);
 
   app.add_subcommand("scenes", "List the shipped scenes");
@@ -216,6 +227,8 @@ int main(int argc, char** argv) {
         if (benchCommand->count("--frames") == 0) benchArguments.frames = 10;
         if (benchCommand->count("--repeats") == 0) benchArguments.repeats = 1;
         if (benchCommand->count("--naive-iterations") == 0) benchArguments.naiveIterations = {10};
+        if (benchCommand->count("--touch-sizes") == 0) benchArguments.touchSizes = {8};
+        if (benchCommand->count("--touch-budget") == 0) benchArguments.touchBudget = 2.0;
       }
       return bench(benchArguments);
     }
