@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1024));
   benchCommand
       ->add_option("--touch-budget", benchArguments.touchBudget,
-                   "Seconds of stepping a touch case may take; it stops there and says how far it got (default 120)")
+                   "Seconds of stepping a touch case may take; it stops there and says how far it got (default 60)")
       ->check(CLI::Range(0.001, 1.0e6));
   benchCommand->add_option("--frames", benchArguments.frames, "Frames per run (default 120)")
       ->transform(kDecimal)
