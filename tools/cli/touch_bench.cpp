@@ -167,17 +167,21 @@ std::string touchSection(const std::vector<TouchRow>& rows, double budgetSeconds
         "Intersecting pairs are counted exactly (`sim/intersections.hpp`) every "
      << kCountEvery
      << " frames and at the last, outside the timed part. Bytes per particle: the most the world held at "
-        "any count. \"same\": the final positions are the same bit for bit on every thread count.\n\n"
+        "any count. \"same\": the final positions are the same bit for bit on every thread count that "
+        "played as many frames (\"-\": none did, so nothing was compared).\n\n"
      << "| case | N | particles | distance | threads | frames | ms / frame | worst frame | free strain (end) | "
         "worst (any frame) | intersecting pairs (end) | most | bytes / particle | same |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  const auto same = [&](const TouchRow& r) {
+  // "yes" or "**no**" against the other thread counts that played as many frames; "-" where none
+  // did (a budget stopped them at different frames): nothing was compared.
+  const auto same = [&](const TouchRow& r) -> std::string {
+    bool compared = false;
     for (const TouchRow& other : rows) {
-      if (other.name == r.name && other.n == r.n && other.framesRun == r.framesRun && other.hash != r.hash) {
-        return false;
-      }
+      if (&other == &r || other.name != r.name || other.n != r.n || other.framesRun != r.framesRun) continue;
+      if (other.hash != r.hash) return "**no**";
+      compared = true;
     }
-    return true;
+    return compared ? "yes" : "-";
   };
   for (const TouchRow& r : rows) {
     md << "| " << r.name << " | " << r.n << " | " << r.particles << " | "
@@ -186,7 +190,7 @@ std::string touchSection(const std::vector<TouchRow>& rows, double budgetSeconds
        << (r.diverged ? " (diverged)" : "") << " | " << format("%.2f", r.msPerFrame) << " | "
        << format("%.1f", r.msWorstFrame) << " | " << percent(r.freeStrainEnd) << " | " << percent(r.freeStrainWorst)
        << " | " << r.pairsEnd << " | " << r.pairsWorst << " | " << format("%.0f", r.bytesPerParticle) << " | "
-       << (same(r) ? "yes" : "**no**") << " |\n";
+       << same(r) << " |\n";
   }
   md << "\nWhere the time goes, ms per frame by stage:\n\n";
   for (const TouchRow& r : rows) {
