@@ -62,9 +62,9 @@ std::uint64_t positionHash(const sim::World& world) {
 }  // namespace
 
 std::vector<TouchCase> touchCases() {
-  return {{"desk crumple", "desk", "assets/gestures/crumple.json"},
-          {"desk fold", "desk", "assets/gestures/fold.json"},
-          {"desk tear", "desk-tear", "assets/gestures/tear.json"},
+  return {{"desk crumple", "desk", "crumple.json"},
+          {"desk fold", "desk", "fold.json"},
+          {"desk tear", "desk-tear", "tear.json"},
           {"drape-sphere", "drape-sphere", ""},
           {"table edge", "table", ""}};
 }
@@ -83,7 +83,11 @@ TouchRow playTouchCase(const TouchCase& c, int n, int threads, double budgetSeco
     self.distance = std::min<double>(self.distance, kThicknessPerSpacing * spacing);
     row.distance = self.distance;
   }
-  Playback playback(scene, c.gesture.empty() ? std::nullopt : std::optional<std::string>(c.gesture));
+  // The shipped gestures, beside the shipped scenes, wherever the bench is run from.
+  const std::optional<std::string> gesture =
+      c.gesture.empty() ? std::nullopt
+                        : std::optional<std::string>((scene::sceneDirectory().parent_path() / "gestures" / c.gesture).string());
+  Playback playback(scene, gesture);
   sim::World& world = playback.world();
   world.setThreads(threads);
   row.frames = static_cast<int>(stepCount(scene, std::nullopt, std::nullopt, playback.script()));

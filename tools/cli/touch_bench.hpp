@@ -14,7 +14,7 @@ namespace drape::cli {
 struct TouchCase {
   std::string name;     // "desk crumple"
   std::string scene;    // a shipped scene
-  std::string gesture;  // a gesture script, or "" for none
+  std::string gesture;  // a shipped gesture script (assets/gestures), or "" for none
 };
 
 // The cases the bench plays by default.
