@@ -140,7 +140,8 @@ std::size_t SelfContact::bytes() const {
   std::size_t total = b(clothOf_) + b(rest_) + b(triangles_) + b(edges_) + b(edgeTriangles_) + b(vertexStart_) +
                       b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) + b(upper_) + b(boxLower_) +
                       b(boxUpper_) + b(pairs_) + b(active_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) +
-                      b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
+                      b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) +
+                      b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
   for (const std::vector<Pair>& found : found_) total += b(found);
@@ -712,6 +713,11 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
   const std::size_t n = x_.size();
   triangleMoved_.assign(triangles_.size(), 0);
   if (inZone_.size() != n) inZone_.assign(n, 0);
+  if (stays_.size() != n) stays_.assign(n, 0);
+  bool anyStays = false;                       // a zone stayed at x0 this substep (counted once in the fallbacks)
+  std::vector<std::uint32_t>& stuck = stuck_;  // per round: the zones of pairs that joined nothing
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>& everPassing = everPassing_;  // every round's, in order
+  everPassing.clear();
   zone_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) zone_[i] = i;
   const auto root = [&](std::uint32_t i) {
@@ -844,7 +850,22 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
       make(at0, x0_, t);
       if (!through(made0_[slot0_[s]], made0_[slot0_[t]])) passing.push_back({s, t});
     }
-    if (passing.empty()) break;
+    // Before ending: every pair that passed in an earlier round, tested again as the particles
+    // are now. A round's move may leave a pair that still passes where it is (its corners in a
+    // zone whose move did not change, while other pairs joined), and the next round tests only the
+    // triangles that moved.
+    bool verifying = false;
+    if (passing.empty()) {
+      for (const auto& [s, t] : everPassing) {
+        make(atX, x_, s);
+        make(atX, x_, t);
+        if (through(madeX_[slotX_[s]], madeX_[slotX_[t]])) passing.push_back({s, t});
+      }
+      if (passing.empty()) break;
+      verifying = true;
+    } else {
+      everPassing.insert(everPassing.end(), passing.begin(), passing.end());
+    }
     // A pair's free corners join one zone, which moves as one body from x0 by the mass-weighted mean
     // of its particles' motions: the zone is then as it was at x0, where none of its triangles
     // intersect, and its momentum is kept. Held and pinned corners are obstacles that move as their
@@ -852,6 +873,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     // none): then they join the zone too, and it moves as they do on average (they count as
     // infinitely heavy), the finger's grip slipping for the substep.
     bool joined = false;
+    stuck.clear();
     for (const auto& [s, t] : passing) {
       std::uint32_t corners[6], zoneOfFree = kNone;
       bool oneZone = true, anyFree = false;
@@ -865,28 +887,52 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
       }
       const bool withHeld = !anyFree || oneZone;
       std::uint32_t r = kNone;
+      bool grew = false;  // this pair joined a particle or two zones
       for (const std::uint32_t v : corners) {
         if (w_[v] == 0.0 && !withHeld) continue;
         if (!inZone_[v]) {
           inZone_[v] = 1;
           members.push_back(v);
-          joined = true;
+          grew = true;
         }
         const std::uint32_t q = root(v);
         if (r == kNone) {
           r = q;
         } else if (q != r) {
           zone_[q] = r;
-          joined = true;
+          grew = true;
         }
       }
+      joined = joined || grew;
+      if (!grew) stuck.push_back(r);
     }
-    if (!joined || round > n) {
-      // Rounding alone (a zone moved by a translation its triangles do not survive on the exact
-      // grid): the zones go back to x0 exactly.
-      for (const std::uint32_t i : members) x_[i] = x0_[i];
+    // A pair that joined nothing goes on through with its corners in one zone already: the zone's
+    // move as one body does not clear it (a translation its triangles do not survive on the exact
+    // grid, where two layers or the two sides of a fresh tear lie closer than its rounding, or
+    // grips that disagree). Once no pair joins anything new, or when the last look above finds the
+    // pair still through, that zone stays at x0 for the substep and the rounds go on: what passes
+    // through a zone that stays joins it and stays too. Every round joins particles or zones or
+    // stops one zone more, so the rounds end; and x0 is clear, so the zones that stay are. Where
+    // nothing is left to join or stop (x0 itself not clear on the exact grid), the whole substep
+    // goes back to x0, where it began.
+    std::vector<std::uint8_t>& stays = staysRoot_;
+    stays.assign(n, 0);
+    for (const std::uint32_t i : members) stays[root(i)] |= stays_[i];
+    bool stopped = false;
+    for (const std::uint32_t r : stuck) {
+      if (joined && !verifying) break;  // while zones grow, a pair that joined nothing waits
+      if (r == kNone || stays[root(r)]) continue;
+      stays[root(r)] = 1;
+      stopped = true;
+    }
+    if ((!joined && !stopped) || round > 2 * n + 2) {
+      x_ = x0_;
       ++stats_.fallbacks;
       break;
+    }
+    if (stopped && !anyStays) {
+      ++stats_.fallbacks;
+      anyStays = true;
     }
     sum.assign(n, Vec3{0.0});
     weight.assign(n, 0.0);
@@ -903,7 +949,8 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     std::fill(triangleMoved_.begin(), triangleMoved_.end(), 0);
     for (const std::uint32_t i : members) {
       const std::uint32_t r = root(i);
-      const Vec3 moved = x0_[i] + sum[r] / weight[r];
+      stays_[i] = stays[r];
+      const Vec3 moved = stays[r] ? x0_[i] : x0_[i] + sum[r] / weight[r];
       if (moved != x_[i]) {
         x_[i] = moved;
         for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) triangleMoved_[vertexTriangles_[k]] = 1;
@@ -932,7 +979,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     for (const std::uint32_t t : m->which) m->slot[t] = kNone;
   }
   stats_.zoned += static_cast<std::int64_t>(members.size());
-  for (const std::uint32_t i : members) inZone_[i] = 0;
+  for (const std::uint32_t i : members) inZone_[i] = stays_[i] = 0;
 }
 
 void SelfContact::scatter(std::vector<Cloth>& cloths) const {

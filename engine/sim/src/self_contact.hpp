@@ -38,6 +38,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "drape/sim/settings.hpp"
@@ -151,8 +152,12 @@ class SelfContact {
   // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is
   // in a zone, and (per zone root) whether a held or pinned particle is in it; per triangle, whether
   // the last round moved a corner.
+  // Whether a zone stays at x0 for the substep (its move as one body did not clear a pair through
+  // it): per member, and per zone root in a round; and the round's zones of such pairs.
   std::vector<std::uint32_t> zone_;
-  std::vector<std::uint8_t> inZone_, heavy_, triangleMoved_;
+  std::vector<std::uint8_t> inZone_, heavy_, triangleMoved_, stays_, staysRoot_;
+  std::vector<std::uint32_t> stuck_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> everPassing_;  // the substep's pairs through, each round's
   // Its exact tests: the pairs of triangles of a round (lower index in the high word) and whether
   // each intersects now; the exact triangles made at x0 and at x (slot per triangle, kNone if not
   // made, and the triangles made).
