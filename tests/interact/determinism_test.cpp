@@ -7,13 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <bit>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
 
+#include "drape/sim/metrics.hpp"
 #include "played.hpp"
 
 namespace drape::test {
@@ -22,27 +22,6 @@ namespace {
 constexpr int kSceneSteps = 12;    // every shipped scene, alone (0.2 s at 60 Hz)
 constexpr int kGestureSteps = 60;  // every gesture's first second (at 60 Hz), fingers at work
 constexpr int kThreadCounts[] = {1, 2, 4};
-
-// FNV-1a over every cloth's particle count, positions and previous positions, bit for bit.
-std::uint64_t stateHash(const sim::World& world) {
-  std::uint64_t hash = 14695981039346656037ull;
-  const auto mix = [&](std::uint64_t word) {
-    for (int byte = 0; byte < 8; ++byte) {
-      hash ^= (word >> (8 * byte)) & 0xff;
-      hash *= 1099511628211ull;
-    }
-  };
-  mix(static_cast<std::uint64_t>(world.stepCount()));
-  for (const sim::Cloth& cloth : world.cloths()) {
-    mix(cloth.state.position.size());
-    for (const auto* array : {&cloth.state.position, &cloth.state.previousPosition}) {
-      for (const sim::Vec3& x : *array) {
-        for (int axis = 0; axis < 3; ++axis) mix(std::bit_cast<std::uint64_t>(x[axis]));
-      }
-    }
-  }
-  return hash;
-}
 
 struct Case {
   std::string name;     // "scene hang", "gesture desk/crumple"
@@ -79,12 +58,12 @@ std::uint64_t finalState(const Case& c, int threads) {
     sim::World world(scene::loadScene(kAssets / "scenes" / (c.scene + ".json")).world);
     world.setThreads(threads);
     EXPECT_EQ(world.run(kSceneSteps), sim::StepStatus::ok) << c.name;
-    return stateHash(world);
+    return sim::stateHash(world);
   }
   Played played(c.scene, c.gesture);
   played.world->setThreads(threads);
   for (int i = 0; i < kGestureSteps; ++i) EXPECT_EQ(played.replay->step(), sim::StepStatus::ok) << c.name;
-  return stateHash(*played.world);
+  return sim::stateHash(*played.world);
 }
 
 std::string hex(std::uint64_t hash) {

@@ -15,12 +15,12 @@
 #include "build_info.hpp"
 #include "commands.hpp"
 #include "common.hpp"
-#include "touch_bench.hpp"
 #include "drape/bench/hang2.hpp"
 #include "drape/bench/measure.hpp"
 #include "drape/scene/error.hpp"
 #include "drape/scene/output.hpp"
 #include "drape/sim/world.hpp"
+#include "touch_bench.hpp"
 
 namespace drape::cli {
 
@@ -61,14 +61,6 @@ std::string cpuName() {
   }
   return "unknown CPU";
 }
-
-std::string format(const char* pattern, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, pattern, value);
-  return text;
-}
-
-std::string percent(double strain) { return format("%.2f %%", 100.0 * strain); }
 
 // One block per series (Drape on T threads, the baseline at K sweeps): particles, ms per frame.
 std::string plotData(const std::vector<Row>& rows, const std::vector<int>& threads, const std::vector<int>& sweeps) {

@@ -75,6 +75,14 @@ void Playback::printReports() const {
   for (const std::string& report : replay_->reports()) std::cerr << "drape-cli: warning: " << report << "\n";
 }
 
+std::string format(const char* pattern, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, value);
+  return text;
+}
+
+std::string percent(double strain) { return format("%.2f %%", 100.0 * strain); }
+
 void drawWithGnuplot(const std::filesystem::path& directory, const std::string& script, const std::string& picture) {
   const std::string shown = scene::printable((directory / picture).string(), 200);
   // Drawn to a temporary of our own, renamed into place: the picture appears whole or not at all.

@@ -53,6 +53,11 @@ class Playback {
   std::unique_ptr<interact::Replay> replay_;
 };
 
+// `value` printed by a printf pattern of one double ("%.3f"), for the reports.
+std::string format(const char* pattern, double value);
+// A strain as a percentage with two decimals: 0.0512 -> "5.12 %".
+std::string percent(double strain);
+
 // Runs gnuplot on `script` in `directory`, where the script's files are named relative to it; the
 // script draws to the file its variable `outfile` names, and this makes that `picture` (replaced
 // whole, or not at all). Throws scene::InputError if it cannot.

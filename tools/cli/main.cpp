@@ -200,7 +200,8 @@ int main(int argc, char** argv) {
       ->transform(kDecimal)
       ->check(CLI::Range(0, 100));
   benchCommand->add_flag("--quick", benchArguments.quick,
-                         "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps, touch cases at 8 x 8 for 2 s (each unless given)");
+                         "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps, touch cases at 8 x 8 for 2 s "
+                         "(each unless given)");
   addReportOptions(benchCommand, benchArguments.outDir, benchArguments.report, benchArguments.quiet);
 
   app.add_subcommand("scenes", "List the shipped scenes");

@@ -4,6 +4,7 @@
 // that pass through each other, and the bytes a particle costs.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <utility>
@@ -37,7 +38,7 @@ struct TouchRow {
   std::size_t pairsWorst = 0;  // over the counts (every kCountEvery frames and the last)
   double bytesPerParticle = 0.0;
   bool diverged = false;
-  std::uint64_t hash = 0;  // of every final position's bits: 1 and N threads must agree
+  std::uint64_t hash = 0;  // the final state's (sim::stateHash): 1 and N threads must agree
 };
 
 // Plays `c` at n x n on `threads` threads, for at most `budgetSeconds` of stepping.

@@ -1,6 +1,7 @@
 #include "drape/sim/metrics.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -27,6 +28,26 @@ StrainStats structuralStrain(const World& world) {
   }
   stats.mean = sumAbs / static_cast<double>(stats.count);
   return stats;
+}
+
+std::uint64_t stateHash(const World& world) {
+  std::uint64_t hash = 14695981039346656037ull;
+  const auto mix = [&](std::uint64_t word) {
+    for (int byte = 0; byte < 8; ++byte) {
+      hash ^= (word >> (8 * byte)) & 0xff;
+      hash *= 1099511628211ull;
+    }
+  };
+  mix(static_cast<std::uint64_t>(world.stepCount()));
+  for (const Cloth& cloth : world.cloths()) {
+    mix(cloth.state.position.size());
+    for (const auto* array : {&cloth.state.position, &cloth.state.previousPosition}) {
+      for (const Vec3& x : *array) {
+        for (int axis = 0; axis < 3; ++axis) mix(std::bit_cast<std::uint64_t>(x[axis]));
+      }
+    }
+  }
+  return hash;
 }
 
 Energy energy(const World& world) {

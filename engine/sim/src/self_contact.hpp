@@ -26,9 +26,13 @@
 //    free corners join an impact zone, which moves rigidly from x0 by its mass-weighted mean motion
 //    (as it was at x0, so intersection-free, and with its momentum). Held and pinned corners join
 //    only where a zone of free ones still passes through them (then they count as infinitely heavy
-//    and the grip slips for the substep). Then again, until no pair changes: zones only grow, so it
-//    ends; in the worst case everything moves as one body. Where a zone's move takes a member out
-//    of its box, the pairs are found again first.
+//    and the grip slips for the substep). Then again, testing the pairs whose triangles moved, until
+//    none passes; before the rounds end, every pair that passed in any round is tested once more.
+//    A pair still through with its corners in one zone already (a translation the exact grid's
+//    rounding does not let it survive) stops that zone at x0 for the substep, and what passes
+//    through a zone that stays joins it and stays too. Each round joins or stops something, so it
+//    ends; where nothing is left to join or stop, the whole substep goes back to x0. Where a zone's
+//    move takes a member out of its box, the pairs are found again first.
 //
 // A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
 // it would without self-contact. Deterministic whatever the number of threads: the tree's walk lists
@@ -151,13 +155,13 @@ class SelfContact {
   std::vector<std::uint32_t> active_;  // pairs the sweeps look at
   // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is
   // in a zone, and (per zone root) whether a held or pinned particle is in it; per triangle, whether
-  // the last round moved a corner.
-  // Whether a zone stays at x0 for the substep (its move as one body did not clear a pair through
-  // it): per member, and per zone root in a round; and the round's zones of such pairs.
+  // the last round moved a corner; whether a zone stays at x0 for the substep (its move as one body
+  // did not clear a pair through it), per member and per zone root in a round; the round's zones of
+  // such pairs; and the substep's pairs through, every round's.
   std::vector<std::uint32_t> zone_;
   std::vector<std::uint8_t> inZone_, heavy_, triangleMoved_, stays_, staysRoot_;
   std::vector<std::uint32_t> stuck_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> everPassing_;  // the substep's pairs through, each round's
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> everPassing_;
   // Its exact tests: the pairs of triangles of a round (lower index in the high word) and whether
   // each intersects now; the exact triangles made at x0 and at x (slot per triangle, kNone if not
   // made, and the triangles made).

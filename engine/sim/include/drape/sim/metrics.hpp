@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "drape/sim/world.hpp"
@@ -25,6 +26,10 @@ struct Energy {
 
 StrainStats structuralStrain(const World& world);
 Energy energy(const World& world);
+// FNV-1a over the step count and every cloth's particle count, positions and previous positions,
+// bit for bit: two worlds that will go on the same way hash the same (the determinism test keeps
+// one per shipped scene and gesture; the bench compares thread counts by it).
+std::uint64_t stateHash(const World& world);
 
 // Per-vertex normals (area-weighted sum of adjacent triangle normals, normalised); particles on no
 // triangle get the lattice plane's normal.
