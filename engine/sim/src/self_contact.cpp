@@ -139,12 +139,13 @@ std::size_t SelfContact::bytes() const {
   const auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   std::size_t total = b(clothOf_) + b(rest_) + b(triangles_) + b(edges_) + b(edgeTriangles_) + b(vertexStart_) +
                       b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) + b(upper_) + b(boxLower_) +
-                      b(boxUpper_) + b(pairs_) + b(active_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) +
-                      b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) +
-                      b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
+                      b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) + b(triangleMoved_) +
+                      b(zone_) + b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) +
+                      b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
   for (const std::vector<Pair>& found : found_) total += b(found);
+  for (const std::vector<Contact>& measured : measured_) total += b(measured);
   return total;
 }
 
@@ -464,14 +465,6 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
   };
 
-  // How far apart a pair keeps: `distance`, or less for parts of one cloth closer than that at rest.
-  const auto target = [&](const std::uint32_t* v, bool edges) {
-    if (clothOf_[v[0]] != clothOf_[v[2]]) return distance;
-    const Weights rest = edges ? edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])
-                               : vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
-    return std::min(distance, glm::length(between(rest, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])));
-  };
-
   // Their primitives, in parallel: each thread its run of leaf pairs, joined in that order.
   const auto threads = static_cast<std::size_t>(workers.threads());
   found_.resize(2 * threads);
@@ -499,13 +492,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (c[0] == v || c[1] == v || c[2] == v) continue;
               const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
               if (apart(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) continue;
-              Pair pair{};
-              for (int k = 0; k < 4; ++k) pair.v[k] = corners[k];
-              pair.target = target(corners, false);
-              pair.first = v;
-              pair.second = t;
-              pair.edges = false;
-              vertexTriangle.push_back(pair);
+              vertexTriangle.push_back({{corners[0], corners[1], corners[2], corners[3]}, v, t, kFar, false});
             }
           }
         };
@@ -528,13 +515,8 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
               const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
               if (apart(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
-              Pair pair{};
-              for (int k = 0; k < 4; ++k) pair.v[k] = corners[k];
-              pair.target = target(corners, true);
-              pair.first = std::min(e, f);
-              pair.second = std::max(e, f);
-              pair.edges = true;
-              edgeEdge.push_back(pair);
+              edgeEdge.push_back(
+                  {{corners[0], corners[1], corners[2], corners[3]}, std::min(e, f), std::max(e, f), kFar, true});
             }
           }
         }
@@ -547,6 +529,16 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   }
   for (const std::int64_t compared : boxTests_) tests += compared;
   stats_.boxTests += tests;
+}
+
+bool SelfContact::stillFar(const Pair& p) const {
+  const Real slack = 0.25 * (measuredDistance_ - kProofMargin);
+  if (!(slack > 0.0)) return false;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 d = x_[p.v[k]] - xMeasured_[p.v[k]];
+    if (!(glm::dot(d, d) <= slack * slack)) return false;
+  }
+  return true;
 }
 
 bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
@@ -582,39 +574,78 @@ bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
   return length > 0.0 && (hi[1] + room < lo[0] || hi[0] + room < lo[1]);
 }
 
-void SelfContact::measure(Pair& pair) const {
+SelfContact::Contact SelfContact::measure(const Pair& pair, Real distance) const {
   const std::uint32_t* v = pair.v;
+  Contact contact;
   const Weights weights = pair.edges ? edgeEdgeWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]])
                                      : vertexTriangleWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
-  for (int k = 0; k < 4; ++k) pair.c[k] = weights.c[k];
+  for (int k = 0; k < 4; ++k) {
+    contact.c[k] = weights.c[k];
+    contact.v[k] = v[k];
+  }
+  contact.edges = pair.edges;
   const Vec3 gap = between(weights, x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
-  pair.gap0 = glm::length(gap);
-  pair.normal = pair.gap0 > kCoincident ? gap / pair.gap0 : Vec3{0.0};
-  pair.far = false;
+  contact.gap0 = glm::length(gap);
+  contact.normal = contact.gap0 > kCoincident ? gap / contact.gap0 : Vec3{0.0};
+  contact.push = 0.0;
+  // How far apart the pair keeps: `distance`, or less for parts of one cloth closer than that at rest.
+  contact.target = distance;
+  if (clothOf_[v[0]] == clothOf_[v[2]]) {
+    const Weights rest = pair.edges ? edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])
+                                    : vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
+    contact.target = std::min(distance, glm::length(between(rest, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])));
+  }
+  return contact;
 }
 
 void SelfContact::measurePairs(Real distance, Workers& workers) {
   // Each pair's closest points at x0, the direction between them, and how far apart they keep;
   // except a pair apart by more than `distance` all through the substep (as the solve found it),
   // which no sweep pushes: it is marked far, and the fail-safe looks at it again at its end.
-  workers.run(
-      pairs_.size(),
-      [&](std::size_t begin, std::size_t end, int) {
-        for (std::size_t i = begin; i < end; ++i) {
-          Pair& pair = pairs_[i];
-          pair.push = 0.0;
-          if (apartAlongCentres(pair, distance)) {
-            pair.far = true;
-          } else {
-            measure(pair);
+  // Each thread measures its run of the pairs into its own list, numbering them from 0; the lists
+  // are joined in order, and each thread then numbers its run's contacts from where its list went.
+  const auto threads = static_cast<std::size_t>(workers.threads());
+  measured_.resize(threads);
+  for (std::vector<Contact>& measured : measured_) measured.clear();
+  xMeasured_ = x_;
+  measuredDistance_ = distance;
+  auto measureRun = [&](std::size_t begin, std::size_t end, int thread) {
+    std::vector<Contact>& measured = measured_[static_cast<std::size_t>(thread)];
+    for (std::size_t i = begin; i < end; ++i) {
+      Pair& pair = pairs_[i];
+      if (apartAlongCentres(pair, distance)) {
+        pair.contact = kFar;
+      } else {
+        pair.contact = static_cast<std::uint32_t>(measured.size());
+        measured.push_back(measure(pair, distance));
+      }
+    }
+  };
+  workers.run(pairs_.size(), measureRun, 1024);
+  // (The second loop cuts the pairs as the first did: as many, in as many runs.)
+  std::vector<std::size_t> offset(threads, 0);
+  contacts_.clear();
+  bool split = false;
+  for (std::size_t t = 0; t < threads; ++t) {
+    offset[t] = contacts_.size();
+    if (t > 0 && !measured_[t].empty()) split = true;
+    contacts_.insert(contacts_.end(), measured_[t].begin(), measured_[t].end());
+  }
+  if (split) {
+    workers.run(
+        pairs_.size(),
+        [&](std::size_t begin, std::size_t end, int thread) {
+          const auto from = static_cast<std::uint32_t>(offset[static_cast<std::size_t>(thread)]);
+          for (std::size_t i = begin; i < end; ++i) {
+            if (pairs_[i].contact != kFar) pairs_[i].contact += from;
           }
-        }
-      },
-      1024);
+        },
+        1024);
+  }
 }
 
 void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch) {
-  const auto gapNow = [&](const Pair& p) {
+  const auto gapNow = [&](const Contact& p) {
     Real g = -p.target;
     for (int k = 0; k < 4; ++k) g += p.c[k] * glm::dot(p.normal, x_[p.v[k]]);
     return g;
@@ -623,7 +654,7 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
   // the masses share the move; nothing where that would move a particle more than 1 / kLeverage
   // times as far as the points part (a held vertex against a triangle whose only free corner has a
   // small weight there: the pair is then left to the fail-safe rather than the corner flung).
-  const auto reach = [&](const Pair& p) {
+  const auto reach = [&](const Contact& p) {
     Real denominator = 0.0, most = 0.0;
     for (int k = 0; k < 4; ++k) {
       denominator += p.c[k] * p.c[k] * w_[p.v[k]];
@@ -635,7 +666,7 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
   // Whether the two points still face each other across the normal: their offset along the
   // surface within the size of the primitives (else one slid off the other's side, or a finger
   // flung it far, and the half-space of x0 says nothing about them).
-  const auto facing = [&](const Pair& p) {
+  const auto facing = [&](const Contact& p) {
     Vec3 offset{0.0};
     for (int k = 0; k < 4; ++k) offset += x_[p.v[k]] * p.c[k];
     const Vec3 along = offset - p.normal * glm::dot(p.normal, offset);
@@ -651,14 +682,14 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
   };
   // The pairs a sweep can push: within one more `distance` of their target now.
   active_.clear();
-  for (std::uint32_t i = 0; i < pairs_.size(); ++i) {
-    const Pair& p = pairs_[i];
-    if (!p.far && p.gap0 > kCoincident && gapNow(p) < distance) active_.push_back(i);
+  for (std::uint32_t i = 0; i < contacts_.size(); ++i) {
+    const Contact& p = contacts_[i];
+    if (p.gap0 > kCoincident && gapNow(p) < distance) active_.push_back(i);
   }
   const std::vector<std::uint32_t>& active = active_;
   for (int sweep = 0; sweep < kSweeps; ++sweep) {
     for (const std::uint32_t i : active) {
-      Pair& p = pairs_[i];
+      Contact& p = contacts_[i];
       const Real g = gapNow(p);
       if (g >= 0.0 || !facing(p)) continue;
       const Real lambda = -g * reach(p);
@@ -676,7 +707,7 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
   }
   std::int64_t pushed = 0;
   for (const std::uint32_t i : active) {
-    Pair& p = pairs_[i];
+    Contact& p = contacts_[i];
     if (p.push <= 0.0) continue;
     ++pushed;
     if (friction <= 0.0) continue;
@@ -811,13 +842,17 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
           m = std::max(m, glm::dot(d, d));
         }
       }
-      if (p.far) {
+      if (p.contact == kFar) {
         // Far when the solve began: still apart along the line between their centres, or looked
-        // at as any other pair.
-        if (apartAlongCentres(p, kProofMargin)) continue;
-        measure(p);
+        // at as any other pair. Apart there by more than the distance when measured, they still
+        // are by more than kProofMargin while no corner has moved a quarter of the difference
+        // since (each side's reach along the line grows by its move; the quarter leaves room for
+        // rounding), which is cheaper to tell.
+        if (stillFar(p) || apartAlongCentres(p, kProofMargin)) continue;
+        p.contact = static_cast<std::uint32_t>(contacts_.size());
+        contacts_.push_back(measure(p, distance));
       }
-      if (p.gap0 > std::sqrt(m) + kProofMargin) continue;  // proven apart all the way
+      if (contacts_[p.contact].gap0 > std::sqrt(m) + kProofMargin) continue;  // proven apart all the way
       ++stats_.tested;
       eachTest(p, [&](std::uint32_t s, std::uint32_t t) {
         tests.push_back((static_cast<std::uint64_t>(std::min(s, t)) << 32) | std::max(s, t));

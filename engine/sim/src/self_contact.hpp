@@ -71,16 +71,25 @@ class SelfContact {
   const SelfContactStats& stats() const { return stats_; }
   std::size_t bytes() const;
 
+  // What the broad phase lists: 32 bytes, as many as a hundred a particle in a crumpled pile.
   struct Pair {
     std::uint32_t v[4];           // vertex-triangle: the vertex, the triangle's corners; edge-edge: a0 a1 b0 b1
-    Real c[4];                    // the contact point's weights: (1, -b0, -b1, -b2) or (1 - s, s, -(1 - t), -t)
-    Vec3 normal;                  // at x0, from the second point to the first
-    Real gap0;                    // distance at x0, m
-    Real target;                  // m
-    Real push;                    // correction along the normal this substep, m (for friction)
     std::uint32_t first, second;  // vertex and triangle, or the two edges
+    // Its contact (an index into contacts_), or kFar: apart by more than the distance as the solve
+    // began, so not measured and not pushed.
+    std::uint32_t contact;
     bool edges;
-    bool far;  // apart by more than the distance as the solve began: c, normal and gap0 not made
+  };
+  static constexpr std::uint32_t kFar = 0xffffffffu;
+  // A pair measured at x0 (those not far): what the sweeps push along.
+  struct Contact {
+    Real c[4];           // the contact point's weights: (1, -b0, -b1, -b2) or (1 - s, s, -(1 - t), -t)
+    Vec3 normal;         // at x0, from the second point to the first
+    Real gap0;           // distance at x0, m
+    Real target;         // m
+    Real push;           // correction along the normal this substep, m (for friction)
+    std::uint32_t v[4];  // the pair's
+    bool edges;
   };
   // The pairs last found (by a substep's search, its fail-safe's, or settle's), in the order they
   // are solved (for tests).
@@ -99,8 +108,11 @@ class SelfContact {
   void scatter(std::vector<Cloth>& cloths) const;
   void findPairs(Real distance, Real ahead, Workers& workers);
   void measurePairs(Real distance, Workers& workers);
-  void measure(Pair& pair) const;
+  Contact measure(const Pair& pair, Real distance) const;
   bool apartAlongCentres(const Pair& pair, Real margin) const;
+  // A far pair none of whose corners has moved far enough since it was measured to bring it within
+  // kProofMargin along the line between its centres (what apartAlongCentres would find, sooner).
+  bool stillFar(const Pair& pair) const;
   void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
   void failSafe(Real distance, Workers& workers);
   bool withinBoxes(Real margin) const;
@@ -152,7 +164,11 @@ class SelfContact {
   std::vector<std::vector<Pair>> found_;  // per thread: vertex-triangle pairs, then edge-edge pairs
   std::vector<std::int64_t> boxTests_;    // per thread: primitive boxes compared
   std::vector<Pair> pairs_;
-  std::vector<std::uint32_t> active_;  // pairs the sweeps look at
+  std::vector<Contact> contacts_;               // the pairs not far, in the pairs' order (then the fail-safe's)
+  std::vector<std::vector<Contact>> measured_;  // per thread, as measurePairs makes them
+  std::vector<std::uint32_t> active_;           // contacts the sweeps look at
+  std::vector<Vec3> xMeasured_;                 // x as the pairs were last measured
+  Real measuredDistance_ = 0.0;                 // the distance they were measured for
   // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is
   // in a zone, and (per zone root) whether a held or pinned particle is in it; per triangle, whether
   // the last round moved a corner; whether a zone stays at x0 for the substep (its move as one body
