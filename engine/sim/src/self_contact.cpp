@@ -32,6 +32,8 @@ constexpr Real kTorn = 10.0;
 
 // Triangles a leaf of the broad phase's tree holds at most.
 constexpr std::size_t kLeafTriangles = 2;
+// Pairs of leaves a thread takes at a time when it lists their primitives' pairs.
+constexpr std::size_t kLeafPairBlock = 256;
 
 // Closest point of triangle abc to p, as barycentric weights of a, b, c (by the triangle's Voronoi
 // regions: a corner, an edge, or the inside).
@@ -465,17 +467,26 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
   };
 
-  // Their primitives, in parallel: each thread its run of leaf pairs, joined in that order.
+  // Their primitives, in parallel: blocks of leaf pairs to whichever thread is free (a crumpled
+  // pile's leaves find far more than a flat sheet's: in even runs, one thread had most of the work
+  // and two threads were no faster than one), each block's pairs in its own lists, joined in the
+  // blocks' order, so the same whatever the number of threads.
   const auto threads = static_cast<std::size_t>(workers.threads());
-  found_.resize(2 * threads);
+  const std::size_t blocks = (leafPairs_.size() + kLeafPairBlock - 1) / kLeafPairBlock;
+  found_.resize(2 * blocks);
   boxTests_.assign(threads, 0);
   for (std::vector<Pair>& found : found_) found.clear();
-  workers.run(
-      leafPairs_.size(),
+  workers.runShared(
+      leafPairs_.size(), kLeafPairBlock,
       [&](std::size_t begin, std::size_t end, int thread) {
-        std::vector<Pair>& vertexTriangle = found_[2 * static_cast<std::size_t>(thread)];
-        std::vector<Pair>& edgeEdge = found_[2 * static_cast<std::size_t>(thread) + 1];
-        std::int64_t& compared = boxTests_[static_cast<std::size_t>(thread)];
+        // The block's lists and count on this thread's stack while it fills them: the lists' headers
+        // and the counts of two threads share cache lines, and writing them at every pair and every
+        // test made two threads no faster than one.
+        const std::size_t block = begin / kLeafPairBlock;
+        std::vector<Pair> vertexTriangle, edgeEdge;
+        vertexTriangle.swap(found_[2 * block]);
+        edgeEdge.swap(found_[2 * block + 1]);
+        std::int64_t compared = 0;
         // The vertices of leaf `from` against the triangles of leaf `to`: not those it is a corner of.
         const auto vertices = [&](std::uint32_t from, std::uint32_t to) {
           const Node& other = nodes_[leafNode_[to]];
@@ -520,12 +531,15 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
             }
           }
         }
+        found_[2 * block].swap(vertexTriangle);
+        found_[2 * block + 1].swap(edgeEdge);
+        boxTests_[static_cast<std::size_t>(thread)] += compared;
       },
       64);
   pairs_.clear();
   for (std::size_t k = 0; k < 2; ++k) {
-    for (std::size_t t = 0; t < threads; ++t)
-      pairs_.insert(pairs_.end(), found_[2 * t + k].begin(), found_[2 * t + k].end());
+    for (std::size_t b = 0; b < blocks; ++b)
+      pairs_.insert(pairs_.end(), found_[2 * b + k].begin(), found_[2 * b + k].end());
   }
   for (const std::int64_t compared : boxTests_) tests += compared;
   stats_.boxTests += tests;
@@ -610,7 +624,8 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
   xMeasured_ = x_;
   measuredDistance_ = distance;
   auto measureRun = [&](std::size_t begin, std::size_t end, int thread) {
-    std::vector<Contact>& measured = measured_[static_cast<std::size_t>(thread)];
+    std::vector<Contact> measured;  // (on the thread's stack while it is filled, as in findPairs)
+    measured.swap(measured_[static_cast<std::size_t>(thread)]);
     for (std::size_t i = begin; i < end; ++i) {
       Pair& pair = pairs_[i];
       if (apartAlongCentres(pair, distance)) {
@@ -620,6 +635,7 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
         measured.push_back(measure(pair, distance));
       }
     }
+    measured_[static_cast<std::size_t>(thread)].swap(measured);
   };
   workers.run(pairs_.size(), measureRun, 1024);
   // (The second loop cuts the pairs as the first did: as many, in as many runs.)

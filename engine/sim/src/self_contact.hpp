@@ -161,7 +161,7 @@ class SelfContact {
   std::vector<std::uint32_t> leafNode_;                           // per leaf, its node
   std::vector<std::uint64_t> leafPairs_;  // this search's overlapping leaves (lower in the high word)
   std::vector<std::uint64_t> stack_;      // the walk's node pairs still to look at
-  std::vector<std::vector<Pair>> found_;  // per thread: vertex-triangle pairs, then edge-edge pairs
+  std::vector<std::vector<Pair>> found_;  // per block of leaf pairs: vertex-triangle pairs, then edge-edge pairs
   std::vector<std::int64_t> boxTests_;    // per thread: primitive boxes compared
   std::vector<Pair> pairs_;
   std::vector<Contact> contacts_;               // the pairs not far, in the pairs' order (then the fail-safe's)
