@@ -36,8 +36,9 @@
 //
 // A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
 // it would without self-contact. Deterministic whatever the number of threads: the tree's walk lists
-// the overlapping leaves in one order, their pairs are listed in parallel, each thread its run of
-// them, joined in that order, and solved in it.
+// the overlapping leaves in one order, their pairs are listed in parallel, in blocks of leaves that
+// go to whichever thread is free, each block's in its own lists, joined in the blocks' order, and
+// solved in it; the pairs' contacts are made in each thread's run of them, joined in that order.
 #pragma once
 
 #include <cstdint>
