@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -175,6 +176,17 @@ std::string errorOf(const std::function<void()>& action) {
     return error.what();
   }
   return "(no error)";
+}
+
+TEST(SceneReader, ASpinIsReadInDegreesASecondAndBoundedLikeAColliders) {
+  json document = minimal();
+  EXPECT_EQ(parseScene(document, "s.json").world.cloths.at(0).initialSpin, sim::Vec3{0.0});
+  applyOverride(document, "cloths.0.spin=[0,360,-90]");
+  const sim::Vec3 spin = parseScene(document, "s.json").world.cloths.at(0).initialSpin;
+  EXPECT_DOUBLE_EQ(spin.y, 2.0 * std::numbers::pi);
+  EXPECT_DOUBLE_EQ(spin.z, -0.5 * std::numbers::pi);
+  applyOverride(document, "cloths.0.spin=[0,40000,0]");
+  EXPECT_NE(errorOf([&] { parseScene(document, "s.json"); }).find("s.json: cloths.0.spin"), std::string::npos);
 }
 
 TEST(SceneReader, AFabricIsAPresetOrItsNumbersAndRefusesWhatItReplaces) {

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "bending.hpp"
+#include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 
 namespace drape::sim {
@@ -218,6 +219,76 @@ TEST(BendingBlock, IsFactoredAgainWhenAParticleIsPinnedAndRefusedWhenTooWide) {
   BendingFactor wideFactor;
   EXPECT_FALSE(bending::prepare(wideFactor, wide.bending, far.inverseMass, alphaTilde));
   EXPECT_FALSE(wideFactor.usable);
+}
+
+// A 60 cm square of cotton in free space, spun at a turn a second about `axis`.
+WorldSettings spinningSheet(Vec3 axis) {
+  WorldSettings settings = fabricSheet(24, 24, 0.6, 0.6);
+  settings.gravity = Vec3{0.0};
+  settings.solver.dt = 1.0 / 60.0;
+  settings.solver.substeps = 4;
+  settings.solver.iterations = 8;
+  settings.cloths[0].initialSpin = glm::normalize(axis) * (2.0 * std::numbers::pi);
+  return settings;
+}
+
+TEST(Rotation, ASpunSheetStartsTurningAboutItsCentreOfMassInBothModels) {
+  const Vec3 velocity{0.1, 0.0, 0.0}, spin{0.0, 2.0 * std::numbers::pi, 0.0};
+  WorldSettings settings = spinningSheet(Vec3{0, 1, 0});
+  settings.cloths[0].initialVelocity = velocity;
+  const auto expected = [&](const Cloth& cloth, ParticleIndex i) {
+    return velocity + glm::cross(spin, cloth.state.position[i] - centreOfMass(cloth));
+  };
+  // The position model's velocity is its first substep's: x - x_prev, made so at the first step.
+  settings.solver.substeps = 40;
+  World world(settings);
+  world.step();
+  for (ParticleIndex i : {ParticleIndex{0}, ParticleIndex{300}, ParticleIndex{575}}) {
+    const Vec3 want = expected(world.cloths()[0], i);
+    EXPECT_LT(glm::length(world.velocity(0, i) - want), 0.02 * glm::length(want)) << i;
+  }
+  // The force model keeps its velocities: as they are made, a pinned particle's 0.
+  settings.cloths[0].pins = {Pin{0, 0, std::nullopt}};
+  settings.solver.model = Model::force;
+  settings.cloths[0].fabric.reset();
+  const World springs(settings);
+  for (ParticleIndex i : {ParticleIndex{1}, ParticleIndex{300}, ParticleIndex{575}}) {
+    EXPECT_LT(glm::length(springs.cloths()[0].state.velocity[i] - expected(springs.cloths()[0], i)), 1e-12) << i;
+  }
+  EXPECT_EQ(springs.cloths()[0].state.velocity[0], Vec3{0.0});
+}
+
+TEST(Rotation, AFreeSpinningFabricKeepsItsAngularMomentum) {
+  // Each link moves its particles along its direction at the substep's start (position::alongStart),
+  // a central force between where they were: the momentum stays to rounding (2e-8 here), where
+  // along the link's direction now it lost 38 % in these 5 s (1 / sqrt(1 + (omega h)^2) a substep).
+  // (Not with solver.lines, whose solve still moves along the links' directions now: 36 % lost.)
+  World world(spinningSheet(Vec3{0, 1, 0}));
+  world.step();
+  const Momentum start = momentum(world);
+  // The square's moment of inertia about its normal, m (w^2 + h^2) / 12 on the continuum (the
+  // lattice's, 0.4 % more).
+  const double mass = 0.2 * 0.36, inertia = mass * 0.72 / 12.0;
+  EXPECT_NEAR(start.angular.y / (inertia * 2.0 * std::numbers::pi), 1.0, 0.05);
+  world.run(299);
+  const Momentum end = momentum(world);
+  EXPECT_LT(glm::length(end.angular - start.angular), 1e-6 * glm::length(start.angular));
+  EXPECT_LT(glm::length(end.linear), 1e-12);
+}
+
+TEST(Rotation, ASheetSpunAboutATiltedAxisWobblesAndKeepsItsAngularMomentum) {
+  // Spun at 60 degrees from its normal the sheet wobbles and bends. The bending block's moves are
+  // not along links (a stencil's multiplier follows its C now, not at the substep's start), so the
+  // momentum is kept to 2e-7 here, not to rounding; the issue asks for 1 % over 5 s.
+  World world(spinningSheet(Vec3{0.866, 0.5, 0}));
+  world.step();
+  const Vec3 start = momentum(world).angular;
+  double worst = 0.0;
+  for (int second = 0; second < 5; ++second) {
+    world.run(60);
+    worst = std::max(worst, glm::length(momentum(world).angular - start) / glm::length(start));
+  }
+  EXPECT_LT(worst, 1e-5);
 }
 
 }  // namespace

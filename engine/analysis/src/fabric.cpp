@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 
 namespace drape::analysis {
@@ -93,6 +94,45 @@ sim::WorldSettings labWorld(const Spec& spec) {
 }
 
 }  // namespace
+
+SpinResult spin(const SpinSpec& spec) {
+  const auto started = std::chrono::steady_clock::now();
+  sim::WorldSettings settings;
+  settings.gravity = sim::Vec3{0.0};
+  settings.solver.dt = 1.0 / 60.0;
+  settings.solver.substeps = spec.substeps;
+  settings.solver.iterations = spec.iterations;
+  settings.solver.lines = spec.lines;
+  sim::ClothSettings cloth;
+  const int cells = std::max(1, static_cast<int>(std::lround(spec.side / spec.spacing)));
+  cloth.lattice.columns = cloth.lattice.rows = cells + 1;
+  cloth.lattice.width = cloth.lattice.height = spec.spacing * cells;
+  cloth.lattice.origin = sim::Vec3{-0.5 * cloth.lattice.width, 1.0, -0.5 * cloth.lattice.height};
+  cloth.fabric = spec.fabric;
+  cloth.initialSpin = sim::Vec3{std::sin(spec.tilt), std::cos(spec.tilt), 0.0} * (2.0 * std::numbers::pi * spec.turns);
+  settings.cloths.push_back(cloth);
+  sim::World world(settings);
+  SpinResult result;
+  // The Verlet history, and so the velocity, starts at the first step.
+  if (world.step() != sim::StepStatus::ok) {
+    result.diverged = true;
+    return result;
+  }
+  const sim::Vec3 start = sim::momentum(world).angular;
+  const double size = glm::length(start);
+  const auto perSecond = static_cast<std::int64_t>(std::lround(1.0 / settings.solver.dt));
+  for (double t = 0.0; t < spec.seconds - 1e-9; t += 1.0) {
+    if (world.run(perSecond) != sim::StepStatus::ok) {
+      result.diverged = true;
+      return result;
+    }
+    result.drift = std::max(result.drift, glm::length(sim::momentum(world).angular - start) / size);
+  }
+  result.kept = glm::dot(sim::momentum(world).angular, start) / (size * size);
+  result.strain = sim::structuralStrain(world).max;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
 
 CantileverResult cantilever(const CantileverSpec& spec) {
   const auto started = std::chrono::steady_clock::now();

@@ -132,6 +132,7 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
   using nlohmann::json;
   const sim::StrainStats strain = sim::structuralStrain(world);
   const sim::Energy energy = sim::energy(world);
+  const sim::Momentum momentum = sim::momentum(world);
   json document;
   document["scene"] = scene.name;
   document["source"] = scene.source;
@@ -159,7 +160,11 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
                           {{"kinetic", energy.kinetic},
                            {"gravitational", energy.gravitational},
                            {"elastic", energy.elastic},
-                           {"total", energy.total()}}}};
+                           {"total", energy.total()}}},
+                         {"momentum",
+                          {{"linear", {momentum.linear.x, momentum.linear.y, momentum.linear.z}},
+                           {"angular", {momentum.angular.x, momentum.angular.y, momentum.angular.z}},
+                           {"centre", {momentum.centre.x, momentum.centre.y, momentum.centre.z}}}}};
   json cloths = json::array();
   for (const sim::Cloth& cloth : world.cloths()) {
     json positions = json::array();

@@ -20,6 +20,9 @@ namespace drape::scene {
 
 namespace {
 
+constexpr double kDegrees = 3.14159265358979323846 / 180.0;  // radians a degree
+
+
 using nlohmann::json;
 using sim::ConstraintKind;
 using sim::KindMaterial;
@@ -175,6 +178,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
     cloth.fabric = readFabric(reader, model);
     cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
     cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
+    cloth.initialSpin = reader.vec3("spin", sim::Vec3{0.0}, 36000.0, "degrees/s") * kDegrees;
     cloth.thickness = reader.number("thickness", cloth.thickness, {1.0e-4, 0.1, false, "m"});
     for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model, xpbd);
     reader.finish();
@@ -204,6 +208,7 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
   }
   cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
   cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
+  cloth.initialSpin = reader.vec3("spin", sim::Vec3{0.0}, 36000.0, "degrees/s") * kDegrees;
   cloth.thickness = reader.number("thickness", cloth.thickness, {1.0e-4, 0.1, false, "m"});
   for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = readMaterial(reader, kind, model, xpbd);
 
@@ -466,6 +471,7 @@ sim::ClothSettings drawnClothTemplate(const Scene& scene) {
     cloth.masses.clear();
     cloth.outline.reset();
     cloth.initialVelocity = sim::Vec3{0.0};
+    cloth.initialSpin = sim::Vec3{0.0};
     return cloth;
   }
   sim::ClothSettings cloth;

@@ -547,7 +547,7 @@ void solveLoose(Cloth& cloth, const SolverScratch& scratch, Real stiffness, bool
   const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
   for (const std::uint32_t k : scratch.looseStretch) {
     if (xpbd && looseLambda) {
-      position::projectCompliant(s.position, s.inverseMass, stretch[k], alphaTilde, looseLambda[k]);
+      position::projectCompliant(s.position, s.previousPosition, s.inverseMass, stretch[k], alphaTilde, looseLambda[k]);
     } else {
       position::projectDistance(s.position, s.inverseMass, stretch[k], stiffness);
     }

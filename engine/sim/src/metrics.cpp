@@ -50,6 +50,41 @@ std::uint64_t stateHash(const World& world) {
   return hash;
 }
 
+Vec3 centreOfMass(const Cloth& cloth) {
+  Vec3 sum{0.0};
+  double mass = 0.0;
+  for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+    sum += static_cast<double>(cloth.state.mass[i]) * cloth.state.position[i];
+    mass += cloth.state.mass[i];
+  }
+  return mass > 0.0 ? sum / mass : Vec3{0.0};
+}
+
+Momentum momentum(const World& world) {
+  Momentum p;
+  double mass = 0.0;
+  Vec3 weighted{0.0};
+  const auto free = [&](const auto& visit) {
+    for (std::size_t c = 0; c < world.cloths().size(); ++c) {
+      const ParticleState& s = world.cloths()[c].state;
+      for (std::size_t i = 0; i < s.position.size(); ++i) {
+        if (s.inverseMass[i] > 0.0)
+          visit(static_cast<double>(s.mass[i]), s.position[i],
+                world.velocity(static_cast<int>(c), static_cast<ParticleIndex>(i)));
+      }
+    }
+  };
+  free([&](double m, const Vec3& x, const Vec3& v) {
+    mass += m;
+    weighted += m * x;
+    p.linear += m * v;
+  });
+  if (!(mass > 0.0)) return p;
+  p.centre = weighted / mass;
+  free([&](double m, const Vec3& x, const Vec3& v) { p.angular += m * glm::cross(x - p.centre, v); });
+  return p;
+}
+
 Energy energy(const World& world) {
   Energy e;
   const Vec3 g = world.settings().gravity;

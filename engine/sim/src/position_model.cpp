@@ -1,5 +1,7 @@
 #include "position_model.hpp"
 
+#include "drape/sim/metrics.hpp"
+
 #include "aerodynamics.hpp"
 #include "bending.hpp"
 #include "contacts.hpp"
@@ -26,15 +28,27 @@ Real relaxation(Real kh) { return kh > 0.0 ? -std::expm1(-kh) / kh : 1.0; }
 
 void startHistory(Cloth& cloth, Vec3 acceleration, Real k, Real h) {
   ParticleState& s = cloth.state;
-  const Vec3 v0 = cloth.settings.initialVelocity;
-  // Exact displacement over [0, h] of du/dt = a - k u, u(0) = v0: a h^2 / 2 + v0 h when k = 0.
   const Real kh = k * h;
-  const Vec3 displacement = kh > 0.0 ? acceleration / k * h + (v0 - acceleration / k) * (h * relaxation(kh))
-                                     : v0 * h + 0.5 * acceleration * h * h;
-  // Choose x_prev so that the first step, x1 = x0 + (x0 - x_prev) e^{-kh} + a h^2 relaxation, moves exactly that far.
-  const Vec3 back = (displacement - acceleration * (h * h * relaxation(kh))) * std::exp(kh);
+  const auto backFor = [&](Vec3 v0) {
+    // Exact displacement over [0, h] of du/dt = a - k u, u(0) = v0: a h^2 / 2 + v0 h when k = 0.
+    const Vec3 displacement = kh > 0.0 ? acceleration / k * h + (v0 - acceleration / k) * (h * relaxation(kh))
+                                       : v0 * h + 0.5 * acceleration * h * h;
+    // Choose x_prev so that the first step, x1 = x0 + (x0 - x_prev) e^{-kh} + a h^2 relaxation, moves exactly that far.
+    return (displacement - acceleration * (h * h * relaxation(kh))) * std::exp(kh);
+  };
+  const Vec3 spin = cloth.settings.initialSpin;
+  const bool spins = glm::dot(spin, spin) > 0.0;
+  const Vec3 back = backFor(cloth.settings.initialVelocity);
+  const Vec3 centre = spins ? centreOfMass(cloth) : Vec3{0.0};
   for (std::size_t i = 0; i < s.position.size(); ++i) {
-    s.previousPosition[i] = s.inverseMass[i] > 0.0 ? s.position[i] - back : s.position[i];
+    if (s.inverseMass[i] == 0.0) {
+      s.previousPosition[i] = s.position[i];
+    } else if (spins) {
+      s.previousPosition[i] =
+          s.position[i] - backFor(cloth.settings.initialVelocity + glm::cross(spin, s.position[i] - centre));
+    } else {
+      s.previousPosition[i] = s.position[i] - back;
+    }
   }
 }
 
@@ -120,9 +134,10 @@ void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inver
 }
 
 // XPBD (Macklin et al. 2016, eq. 18): with C = |x_b - x_a| - r and alpha~ = compliance / h^2,
-// dlambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~), x_a -= w_a dlambda n, x_b += w_b dlambda n.
-void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inverseMass, const DistanceConstraint& c,
-                      Real alphaTilde, Real& lambda) {
+// dlambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~), x_a -= w_a dlambda n0, x_b += w_b dlambda n0,
+// n0 the link's direction at the substep's start (alongStart).
+void projectCompliant(std::vector<Vec3>& position, const std::vector<Vec3>& start, const std::vector<Real>& inverseMass,
+                      const DistanceConstraint& c, Real alphaTilde, Real& lambda) {
   const Real wa = inverseMass[c.a], wb = inverseMass[c.b];
   const Real denominator = wa + wb + alphaTilde;
   if (denominator == 0.0) return;
@@ -132,7 +147,7 @@ void projectCompliant(std::vector<Vec3>& position, const std::vector<Real>& inve
   const Real length = std::sqrt(length2);
   const Real deltaLambda = (-(length - c.restLength) - alphaTilde * lambda) / denominator;
   lambda += deltaLambda;
-  const Vec3 n = d / length;
+  const Vec3 n = alongStart(d / length, start[c.a], start[c.b]);
   position[c.a] -= n * (wa * deltaLambda);
   position[c.b] += n * (wb * deltaLambda);
 }
@@ -264,7 +279,7 @@ void projectRange(ParticleState& s, const DistanceConstraint* constraints, std::
 void projectCompliantRange(ParticleState& s, const DistanceConstraint* constraints, Real* lambda, std::size_t begin,
                            std::size_t end, Real alphaTilde) {
   for (std::size_t k = begin; k < end; ++k)
-    projectCompliant(s.position, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
+    projectCompliant(s.position, s.previousPosition, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
 }
 
 // A fabric's bend stencils, in order (XPBD on the vector constraint C = sum k_j (x_j - x_0), which is

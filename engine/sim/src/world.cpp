@@ -1,5 +1,7 @@
 #include "drape/sim/world.hpp"
 
+#include "drape/sim/metrics.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cassert>
@@ -50,6 +52,7 @@ void validateCloth(const ClothSettings& cloth, Model model) {
           "cloth mass per particle must be a positive number with a finite inverse");
   require(finite(cloth.lattice.origin), "cloth origin must be finite");
   require(finite(cloth.initialVelocity), "cloth velocity must be finite");
+  require(finite(cloth.initialSpin), "cloth spin must be finite");
   for (const KindMaterial& m : cloth.materials) {
     require(finite(m.stiffness) && m.stiffness >= 0.0 && finite(m.damping) && m.damping >= 0.0,
             "constraint stiffness and damping must be finite and >= 0");
@@ -212,8 +215,14 @@ Cloth makeCloth(const ClothSettings& given, Model model) {
   s.previousPosition = s.position;
   if (model == Model::force) {
     s.velocity.assign(n, settings.initialVelocity);
+    const Vec3 spin = settings.initialSpin;
+    const Vec3 centre = glm::dot(spin, spin) > 0.0 ? centreOfMass(cloth) : Vec3{0.0};
     for (std::size_t i = 0; i < n; ++i) {
-      if (s.inverseMass[i] == 0.0) s.velocity[i] = Vec3{0.0};
+      if (s.inverseMass[i] == 0.0) {
+        s.velocity[i] = Vec3{0.0};
+      } else if (glm::dot(spin, spin) > 0.0) {
+        s.velocity[i] += glm::cross(spin, s.position[i] - centre);
+      }
     }
   }
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);

@@ -83,6 +83,30 @@ struct CusickResult {
 // is the mesh's triangles projected onto the table, counted on a grid of 0.5 mm cells.
 CusickResult cusick(const CusickSpec& spec);
 
+// Rotation kept: a square of fabric in free space (no gravity, drag or damping), spun about an
+// axis `tilt` off its normal, and how much of its angular momentum it keeps.
+struct SpinSpec {
+  sim::Fabric fabric;
+  double side = 0.30;       // m
+  double spacing = 0.0125;  // m, the lattice's
+  double turns = 1.0;       // a second
+  double tilt = 0.0;        // radians between the spin axis and the sheet's normal
+  int substeps = 10;
+  int iterations = 4;
+  bool lines = false;
+  double seconds = 5.0;  // s
+};
+
+struct SpinResult {
+  double kept = 0.0;     // L(end) . L(start) / |L(start)|^2 (1: all of it)
+  double drift = 0.0;    // the most |L(t) - L(start)| / |L(start)| over each second's end
+  double strain = 0.0;   // the longest stretch link's strain at the end
+  double seconds = 0.0;  // wall-clock
+  bool diverged = false;
+};
+
+SpinResult spin(const SpinSpec& spec);
+
 // Of a shadow's edge radius sampled at equal angles going round: how many times it rises through
 // its mean (after a moving average over `smoothing` samples either side).
 int nodeCount(const std::vector<double>& radius, int smoothing);

@@ -24,7 +24,17 @@ struct Energy {
   double total() const { return kinetic + gravitational + elastic; }
 };
 
+// Momentum of the particles a force or constraint moves (not pinned, not held), every cloth together.
+struct Momentum {
+  Vec3 linear{0.0};   // kg m/s, sum of m v
+  Vec3 angular{0.0};  // kg m^2/s, sum of m (x - centre) x v
+  Vec3 centre{0.0};   // m, their centre of mass, which `angular` is taken about
+};
+
 StrainStats structuralStrain(const World& world);
+Momentum momentum(const World& world);
+// Mass-weighted mean of the cloth's positions, every particle counted (pinned too).
+Vec3 centreOfMass(const Cloth& cloth);
 Energy energy(const World& world);
 // FNV-1a over the step count and every cloth's particle count, positions and previous positions,
 // bit for bit: two worlds that will go on the same way hash the same (the determinism test keeps

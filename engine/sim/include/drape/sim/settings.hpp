@@ -126,7 +126,10 @@ struct ClothSettings {
   std::optional<OutlineSpec> outline;
   Real mass = 1.0;            // kg, spread evenly over the particles of a lattice
   Vec3 initialVelocity{0.0};  // m/s, of every unpinned particle at the start
-  Real thickness = 0.005;     // m, how close a particle comes to a collider's surface
+  // rad/s: every unpinned particle also starts turning at this angular velocity about the cloth's
+  // centre of mass, v = initialVelocity + initialSpin x (x - centre).
+  Vec3 initialSpin{0.0};
+  Real thickness = 0.005;  // m, how close a particle comes to a collider's surface
   std::array<KindMaterial, kConstraintKindCount> materials{};
   std::vector<Pin> pins;
   std::vector<ParticleMass> masses;  // lattice only: these particles weigh this much instead
