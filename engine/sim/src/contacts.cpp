@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
 
@@ -17,23 +18,29 @@ struct Candidate {
   Real offset = 0.0;
 };
 
-// The contact plane, if the motion from `from` to `to` comes within `thickness` of the collider.
+// The contact plane, if the motion from `from` to `to` comes within `near` (twice the thickness) of
+// the collider. The plane itself lies `thickness` off the surface: a particle is pushed only if
+// the sweeps take it closer than that. The margin is for what the sweeps do after the inertial
+// motion: a particle resting on a ball that the last substep's push left moving outwards predicts a
+// path that stays clear of the skin, and the cloth's pull then took it 0.37 mm into it unopposed;
+// found there the next substep and pushed out, it flipped 0.3-0.6 mm every substep forever.
 Candidate touch(const Collider& collider, int index, Vec3 previous, Vec3 to, Real thickness) {
   const Vec3 from = collider.carried(previous);  // in the collider's frame, the particle came from here
   const Vec3 motion = to - from;
   const Real travel = glm::length(motion);
-  const Real reach = travel + 2.0 * thickness + 1e-6;
+  const Real near = 2.0 * thickness;
+  const Real reach = travel + 2.0 * near + 1e-6;
   const SurfaceDistance start = collider.distance(from, reach);
   if (start.distance >= reach) return {};
   const auto planeThrough = [&](Vec3 p, const SurfaceDistance& d) {
     return Candidate{index, d.normal, glm::dot(d.normal, p - d.normal * d.distance) + thickness};
   };
-  if (start.distance < thickness) {
-    // Already touching (resting contact): keep to the side it started on. The surface nearest the
+  if (start.distance < near) {
+    // Touching or all but (resting contact): keep to the side it started on. The surface nearest the
     // end serves while it faces the same way; past the middle of a thin solid it would be the far
     // face, and would push the particle out underneath.
     const SurfaceDistance end = collider.distance(to, reach);
-    if (collider.settings().shape != ColliderShape::mesh && end.distance < thickness &&
+    if (collider.settings().shape != ColliderShape::mesh && end.distance < near &&
         glm::dot(end.normal, start.normal) > 0.0) {
       return planeThrough(to, end);
     }
@@ -43,7 +50,7 @@ Candidate touch(const Collider& collider, int index, Vec3 previous, Vec3 to, Rea
   Real t = 0.0;
   SurfaceDistance here = start;
   while (travel > 0.0) {
-    if (here.distance < thickness) return planeThrough(from + motion * t, here);
+    if (here.distance < near) return planeThrough(from + motion * t, here);
     t += std::max(std::max(here.distance - thickness * 0.5, thickness * 0.25) / travel, 1.0 / 256.0);
     // Also ends a march that met a NaN: a motion near the double range (a particle flung 1e307 m)
     // overflows its length to inf, and the distance at a point of it can be inf - inf.
@@ -52,7 +59,7 @@ Candidate touch(const Collider& collider, int index, Vec3 previous, Vec3 to, Rea
   }
   // The end point itself (the march may step past a surface it only grazes at the end).
   const SurfaceDistance end = collider.distance(to, reach);
-  if (end.distance < thickness) return planeThrough(to, end);
+  if (end.distance < near) return planeThrough(to, end);
   return {};
 }
 
@@ -71,7 +78,7 @@ void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch&
   for (std::size_t i = 0; i < n; ++i) {
     scratch.contactCollider[i] = -1;
     if (s.inverseMass[i] == 0.0) continue;
-    Real deepest = -thickness;
+    Real deepest = -std::numeric_limits<Real>::infinity();
     for (std::size_t c = 0; c < colliders.size(); ++c) {
       const Candidate candidate =
           touch(colliders[c], static_cast<int>(c), s.previousPosition[i], s.position[i], thickness);
