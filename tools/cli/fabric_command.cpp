@@ -286,10 +286,10 @@ int fabric(const FabricArguments& arguments) {
            << "A 30 cm square at 12.5 mm in free space (no gravity, drag or damping) spun at a turn a second\n"
            << "about its normal, or about an axis 60 degrees off it (it wobbles and bends), for 5 s. Kept: its\n"
            << "angular momentum at the end along the start's, L(5) . L(0) / |L(0)|^2; drift: the most\n"
-           << "|L(t) - L(0)| / |L(0)| at each second's end. Target (issue 24): within 1 %. The XPBD projections\n"
-           << "one link at a time move along the link's direction at the substep's start, which keeps it to\n"
-           << "rounding; the lines' solve still moves along the direction now and loses omega^2 h / 2 a second\n"
-           << "(docs/design.md, \"Rotation kept\", says why).\n\n"
+           << "|L(t) - L(0)| / |L(0)| at each second's end. Target (issue 24): within 1 %. Each slack XPBD link\n"
+           << "moves its particles along its direction at the substep's start, a central force between where\n"
+           << "they were, which keeps it; a taut one (none here) along its direction now (docs/design.md,\n"
+           << "\"Rotation kept\", says why).\n\n"
            << "| fabric | tilt (deg) | substeps x sweeps, stretch solver | kept | drift | worst strain | run (s) |\n"
            << "|---|---|---|---|---|---|---|\n";
     int kept = 0, spins = 0;

@@ -36,7 +36,11 @@ struct Line {
 // links p[g].link[0..n-2]. Each line's arithmetic is the same whatever G is; interleaving only lets the core
 // overlap the lines' chains of divisions (Thomas' recurrence is serial within a line).
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
-template <std::size_t G>
+//
+// With kAlongStart (XPBD) each link moves its particles along its direction at the substep's start
+// where it is slack enough (position::alongStart), which keeps the cloth's angular momentum:
+// dx_k = w_k (dlambda_{k-1} n0_{k-1} - dlambda_k n0_k), dlambda from the system above.
+template <std::size_t G, bool kAlongStart>
 void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array<Real*, G>& lambda,
                 const std::array<float*, G>& summed, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
                 Vec3* normal, Real* upper, Real* solution) {
@@ -96,8 +100,14 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
       const Real dl = solution[at] * stiffness;
       if (lambda[g]) lambda[g][k] += dl;
       if (summed[g]) summed[g][k] = static_cast<float>((restart ? 0.0f : summed[g][k]) + dl);
-      const Vec3 push = normal[at] * dl;
       const DistanceConstraint& c = p[g].link[k];
+      Vec3 along = normal[at];
+      if constexpr (kAlongStart) {
+        // (The substep's multiplier so far; a caller that keeps none has only this step's.)
+        along = position::alongStart(along, s.previousPosition[c.a], s.previousPosition[c.b],
+                                     lambda[g] ? lambda[g][k] : dl, w[c.a] + w[c.b], c.restLength);
+      }
+      const Vec3 push = along * dl;
       x[c.a] -= push * w[c.a];
       x[c.b] += push * w[c.b];
     }
@@ -522,17 +532,23 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
               }
             } else {
               // With geometric stiffness every solve adds its multipliers to the tension sums.
-              inGroups<4>(lines, stretch, line, last - first, xpbd,
-                          [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
-                                             const auto& offset, std::size_t n) {
-                            std::array<float*, G> summed{};
-                            for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
-                              summed[g] = lines.tension.data() + offset[g];
-                            }
-                            solveLines<G>(s, p, lambda, summed, restart, n, stiffness, alpha,
-                                          scratch.lineNormal.data() + slice, scratch.lineUpper.data() + slice,
-                                          scratch.lineSolution.data() + slice);
-                          });
+              inGroups<4>(
+                  lines, stretch, line, last - first, xpbd,
+                  [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
+                                     const auto& offset, std::size_t n) {
+                    std::array<float*, G> summed{};
+                    for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
+                      summed[g] = lines.tension.data() + offset[g];
+                    }
+                    Vec3* normal = scratch.lineNormal.data() + slice;
+                    Real* upper = scratch.lineUpper.data() + slice;
+                    Real* solution = scratch.lineSolution.data() + slice;
+                    if (xpbd) {
+                      solveLines<G, true>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
+                    } else {
+                      solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
+                    }
+                  });
             }
           },
           grain);

@@ -147,7 +147,7 @@ void projectCompliant(std::vector<Vec3>& position, const std::vector<Vec3>& star
   const Real length = std::sqrt(length2);
   const Real deltaLambda = (-(length - c.restLength) - alphaTilde * lambda) / denominator;
   lambda += deltaLambda;
-  const Vec3 n = alongStart(d / length, start[c.a], start[c.b]);
+  const Vec3 n = alongStart(d / length, start[c.a], start[c.b], lambda, wa + wb, c.restLength);
   position[c.a] -= n * (wa * deltaLambda);
   position[c.b] += n * (wb * deltaLambda);
 }

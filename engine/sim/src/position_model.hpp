@@ -53,24 +53,28 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
 // x_prev, conserving momentum.
 void dampConstraints(Cloth& cloth);
 
-// Which way a link moves its two particles in an XPBD projection one link at a time
-// (projectCompliant: the sweep, shear and bend batches, the lines' loose links): along its
-// direction at the substep's start, n0 = (b0 - a0) / |b0 - a0|, instead of its direction now, n,
-// as SHAKE does (Ryckaert, Ciccotti and Berendsen 1977). A push along n0 is a central force
-// between where the particles were, so every such projection keeps the cloth's angular momentum,
-// sum m x cross v with v = (x - x_prev) / h, exactly, however few the sweeps. Along n it shrinks a
-// spinning cloth's momentum by 1 / sqrt(1 + (omega h)^2) a substep: 38 % in 5 s at a turn a
-// second and 240 substeps a second. The multiplier is still found along n, so the move shortens
-// the link by n . n0 of what it would along n: a little less, never more. Where the link has
-// turned more than 60 degrees within the substep (a fold snapping through, a crumple, a hard
-// contact) n0 says little about how to shorten it, and n is used.
+// Which way an XPBD link moves its two particles (projectCompliant: the sweep, the shear and bend
+// batches, the loose links; and the lines' solve): along its direction at the substep's start,
+// n0 = (b0 - a0) / |b0 - a0|, instead of its direction now, n, as SHAKE does (Ryckaert, Ciccotti
+// and Berendsen 1977). A push along n0 is a central force between where the particles were, so
+// such moves keep the cloth's angular momentum, sum m x cross v with v = (x - x_prev) / h, exactly,
+// however few the sweeps. Along n it shrinks a spinning cloth's momentum by 1 / sqrt(1 + (omega
+// h)^2) a substep: 38 % in 5 s at a turn a second and 240 substeps a second. The multiplier is
+// still found along n, so the move shortens the link by n . n0 of what it would along n: a little
+// less, never more.
 //
-// The lines' solve (lines.hpp) still moves along n: a whole line's tension applied along n0 is a
-// sideways force taken from the substep's start, explicit, and a taut fine line's sideways waves
-// then grow (a 3.125 mm cotton strip at 10 substeps x 2 sweeps went from 4e-5 to 21 % strain;
-// with the lines' system built from n0 too, a denim sheet dropped on a ball blew up). With lines a
-// spinning cloth loses its momentum as above (docs/design.md).
-inline Vec3 alongStart(const Vec3& n, const Vec3& a0, const Vec3& b0) {
+// But n0 takes the link's sideways pull from the substep's start, explicitly, and a taut link's
+// sideways waves then grow once that pull is stiff against the particles' masses: its geometric
+// stiffness |lambda| / l (lambda the link's multiplier so far this substep, its tension times h^2)
+// times w_a + w_b is (omega h)^2 for its sideways swing. n0 serves while that is below
+// kExplicitSwing, ten times under where it went wrong (with n0 everywhere, a 3.125 mm cotton strip
+// hanging at 10 substeps x 2 sweeps with lines went from 4e-5 to 21 % strain); a taut link moves
+// along n, implicitly (a spinning sheet's links are far below it, a hanging one's near its pins
+// above). So does a link that has turned more than 60 degrees within the substep (a fold snapping
+// through, a crumple, a hard contact), where n0 says little about how to shorten it.
+inline constexpr Real kExplicitSwing = 0.1;
+inline Vec3 alongStart(const Vec3& n, const Vec3& a0, const Vec3& b0, Real lambda, Real wSum, Real restLength) {
+  if (!(std::abs(lambda) * wSum < kExplicitSwing * restLength)) return n;
   const Vec3 d0 = b0 - a0;
   const Real length02 = glm::dot(d0, d0);
   if (!(length02 > 1e-20)) return n;
