@@ -22,7 +22,6 @@ namespace {
 
 constexpr double kDegrees = 3.14159265358979323846 / 180.0;  // radians a degree
 
-
 using nlohmann::json;
 using sim::ConstraintKind;
 using sim::KindMaterial;
