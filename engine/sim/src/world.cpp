@@ -216,11 +216,12 @@ Cloth makeCloth(const ClothSettings& given, Model model) {
   if (model == Model::force) {
     s.velocity.assign(n, settings.initialVelocity);
     const Vec3 spin = settings.initialSpin;
-    const Vec3 centre = glm::dot(spin, spin) > 0.0 ? centreOfMass(cloth) : Vec3{0.0};
+    const bool spins = glm::dot(spin, spin) > 0.0;
+    const Vec3 centre = spins ? centreOfMass(cloth) : Vec3{0.0};
     for (std::size_t i = 0; i < n; ++i) {
       if (s.inverseMass[i] == 0.0) {
         s.velocity[i] = Vec3{0.0};
-      } else if (glm::dot(spin, spin) > 0.0) {
+      } else if (spins) {
         s.velocity[i] += glm::cross(spin, s.position[i] - centre);
       }
     }
