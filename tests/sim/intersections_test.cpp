@@ -37,8 +37,12 @@ TEST(Intersections, TwoTrianglesCountAsTheyMeet) {
 
 TEST(Intersections, NeighboursCountOnlyWhenOnePassesThroughTheOther) {
   const Vec3 v{0, 0, 0}, a{1, 0, 0}, b{0, 1, 0};
-  // Across an edge never, even folded flat onto each other.
-  EXPECT_EQ(pairs({v, a, b, {0.5, 0.5, 0}}, {{0, 1, 2}, {0, 1, 3}}), 0u);
+  // Across an edge: side by side, or folded up to almost flat, they only share the edge.
+  EXPECT_EQ(pairs({v, a, b, {0.5, -0.5, 0}}, {{0, 1, 2}, {0, 1, 3}}), 0u);
+  EXPECT_EQ(pairs({v, a, b, {0.5, 0.5, 1e-6}}, {{0, 1, 2}, {0, 1, 3}}), 0u);
+  // Folded flat onto each other (a triangle turned over on a table), they overlap.
+  EXPECT_EQ(pairs({v, a, b, {0.5, 0.5, 0}}, {{0, 1, 2}, {0, 1, 3}}), 1u);
+  EXPECT_EQ(pairs({v, a, b, {-0.2, 0.1, 0}}, {{0, 1, 2}, {1, 2, 3}}), 1u);
   // At one corner: side by side in a plane, or folded up, they only touch there.
   EXPECT_EQ(pairs({v, a, b, {-1, 0, 0}, {0, -1, 0}}, {{0, 1, 2}, {0, 3, 4}}), 0u);
   EXPECT_EQ(pairs({v, a, b, {-1, 0, 0}, {0, 0, 1}}, {{0, 1, 2}, {0, 3, 4}}), 0u);

@@ -203,6 +203,62 @@ TEST(SelfContact, AFingerDraggedAcrossTheClothAt5MetresASecondNeverPullsItThroug
   EXPECT_GT(highest, 0.005 + 0.8 * kDistance);
 }
 
+// Two triangles that share an edge, folded almost flat onto each other, the free corner of the top
+// one thrown down through the bottom one. Neighbours across an edge intersect only lying flat on
+// each other, so no intersection marks the pass: up to 10 m/s the pushes stop the corner, at 30 m/s
+// (half a metre a step) only the fail-safe's look at the fold carried past its closed position.
+TEST(SelfContact, AFoldThrownThroughItselfAtItsCreaseStaysOnItsSide) {
+  for (const Real speed : {3.0, 30.0, 100.0}) {
+    WorldSettings settings;
+    settings.solver.substeps = 1;
+    settings.solver.iterations = 4;
+    settings.gravity = Vec3{0.0};
+    ClothSettings cloth = flatSheet(2, 0.1, {0.0, 0.5, 0.0});
+    cloth.material(ConstraintKind::shear).stiffness = 0.0;  // no link across the fold
+    cloth.material(ConstraintKind::bend).stiffness = 0.0;
+    settings.cloths.push_back(cloth);
+    World world(withSelfContact(settings));
+    std::vector<Cloth> cloths = world.cloths();
+    const std::vector<glm::uvec3> triangles = cloths[0].rest.triangles;
+    ASSERT_EQ(triangles.size(), 2u);
+    // The shared edge ab; c of the first triangle, d of the second.
+    std::uint32_t c = 0, d = 0;
+    for (int k = 0; k < 3; ++k) {
+      const auto in = [&](std::uint32_t v, const glm::uvec3& t) { return v == t[0] || v == t[1] || v == t[2]; };
+      if (!in(triangles[0][k], triangles[1])) c = triangles[0][k];
+      if (!in(triangles[1][k], triangles[0])) d = triangles[1][k];
+    }
+    ParticleState& state = cloths[0].state;
+    // d folded over onto c's side, 1 cm above its triangle (the mirror of d across ab is c), and
+    // moving down at `speed`.
+    state.position[d] = state.position[c] + Vec3{0.0, 0.01, 0.0};
+    state.previousPosition = state.position;
+    state.previousPosition[d].y += speed * settings.solver.dt;
+    world.restoreCloths(std::move(cloths));
+    // The fold's signed angle between the two triangles about ab, from -pi to pi: 0 folded flat
+    // onto each other, +-pi a flat sheet. The corner goes through the other triangle where the
+    // angle changes sign near 0 (through +-pi the fold just opens).
+    const glm::uvec3 first = triangles[0];
+    const std::uint32_t a = first[0] == c ? first[1] : first[0];
+    const std::uint32_t b = first[2] == c ? first[1] : first[2];
+    const auto fold = [&] {
+      const std::vector<Vec3>& x = world.cloths()[0].state.position;
+      const Vec3 e = glm::normalize(x[b] - x[a]);
+      const Vec3 u = (x[c] - x[a]) - e * glm::dot(x[c] - x[a], e), v = (x[d] - x[a]) - e * glm::dot(x[d] - x[a], e);
+      return std::atan2(glm::dot(glm::cross(u, v), e), glm::dot(u, v));
+    };
+    Real before = fold();
+    ASSERT_LT(std::abs(before), 0.3);
+    for (int step = 0; step < 30; ++step) {
+      world.step();
+      const Real now = fold();
+      ASSERT_FALSE(before * now < 0.0 && std::abs(before) < 1.5 && std::abs(now) < 1.5)
+          << speed << " m/s, step " << step << ": " << before << " -> " << now << " rad";
+      before = now;
+    }
+  }
+}
+
 // A snapshot the fuzzer made (tests/fuzz/crashers/snapshot/timeout-3ec5...): the fold scene's
 // cloth with one particle 1.9e13 m away. Its triangles and edges are torn out of self-contact, but
 // its own box, asked against the hashed grid the broad phase had then, walked every cell from the

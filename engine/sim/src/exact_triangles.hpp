@@ -94,7 +94,20 @@ inline bool intersect(const Triangle& s, const Triangle& t) {
       }
     }
   }
-  if (shared >= 2) return false;  // neighbours across an edge
+  if (shared == 3) return false;  // one triangle twice
+  if (shared == 2) {
+    // Neighbours across an edge ab meet beyond it only folded flat onto each other: their other
+    // corners c and d in one plane with a and b, and on one side of ab there.
+    int c = 0, d = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (s.particle[i] != t.particle[0] && s.particle[i] != t.particle[1] && s.particle[i] != t.particle[2]) c = i;
+      if (t.particle[i] != s.particle[0] && t.particle[i] != s.particle[1] && t.particle[i] != s.particle[2]) d = i;
+    }
+    const Point& a = s.p[(c + 1) % 3];
+    const Point& b = s.p[(c + 2) % 3];
+    if (orient3(s.p[0], s.p[1], s.p[2], t.p[d]) != 0) return false;
+    return s.plane.orient(a, b, s.p[c]) == s.plane.orient(a, b, t.p[d]);
+  }
   if (allOnOneSide(s, t) || allOnOneSide(t, s)) return false;
   if (shared == 1) {
     // They meet at the shared corner; they pass through each other where the edge of one opposite

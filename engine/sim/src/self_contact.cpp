@@ -817,6 +817,45 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     }
     return exact::intersect(*a, unified);
   };
+  // Neighbours across an edge intersect only folded flat onto each other (exact::intersect), but a
+  // fold pressed through, its dihedral angle carried past half a turn from one side to the other
+  // within the substep, passes one through the other all the same: their other corners c and d,
+  // folded more than a quarter turn towards each other at x0 and at x, with d on opposite sides of
+  // the plane of s. `other`: the corner of t that s does not have (-1 when they share no edge).
+  const auto other = [&](std::uint32_t s, std::uint32_t t) {
+    const glm::uvec3 a = triangles_[s], b = triangles_[t];
+    int shared = 0, j = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (b[k] == a[0] || b[k] == a[1] || b[k] == a[2]) {
+        ++shared;
+      } else {
+        j = k;
+      }
+    }
+    return shared == 2 ? j : -1;
+  };
+  const auto folded = [&](const std::vector<Vec3>& x, std::uint32_t s, std::uint32_t t, int j) {
+    const glm::uvec3 a = triangles_[s];
+    const std::uint32_t d = triangles_[t][j];
+    int i = 0;
+    while (a[i] == triangles_[t][0] || a[i] == triangles_[t][1] || a[i] == triangles_[t][2]) ++i;
+    const Vec3 o = x[a[(i + 1) % 3]], e = x[a[(i + 2) % 3]] - o, u = x[a[i]] - o, v = x[d] - o;
+    return glm::dot(u, v) * glm::dot(e, e) - glm::dot(u, e) * glm::dot(v, e) > 0.0;
+  };
+  const auto wrapped = [&](std::uint32_t s, std::uint32_t t) {
+    const int j = other(s, t);
+    if (j < 0 || !folded(x0_, s, t, j) || !folded(x_, s, t, j)) return false;
+    make(at0, x0_, s);
+    make(at0, x0_, t);
+    make(atX, x_, s);
+    make(atX, x_, t);
+    const std::optional<exact::Triangle>&s0 = made0_[slot0_[s]], &t0 = made0_[slot0_[t]];
+    const std::optional<exact::Triangle>&s1 = madeX_[slotX_[s]], &t1 = madeX_[slotX_[t]];
+    if (!s0 || !t0 || !s1 || !t1) return false;
+    const int before = exact::orient3(s0->p[0], s0->p[1], s0->p[2], t0->p[j]);
+    const int after = exact::orient3(s1->p[0], s1->p[1], s1->p[2], t1->p[j]);
+    return before * after < 0;
+  };
   // The triangles the fail-safe tests for a pair: around its vertex against its triangle, or those
   // on its first edge against those on its second.
   const auto eachTest = [&](const Pair& p, auto&& f) {
@@ -888,18 +927,21 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
         [&](std::size_t begin, std::size_t end, int) {
           for (std::size_t i = begin; i < end; ++i) {
             const std::uint64_t key = tests[i];
-            hits[i] = through(madeX_[slotX_[key >> 32]], madeX_[slotX_[static_cast<std::uint32_t>(key)]]);
+            const auto s = static_cast<std::uint32_t>(key >> 32), t = static_cast<std::uint32_t>(key);
+            const int j = other(s, t);
+            hits[i] = through(madeX_[slotX_[s]], madeX_[slotX_[t]]) || (j >= 0 && folded(x_, s, t, j));
           }
         },
         256);
-    // Of those that intersect now, the ones that did not at x0.
+    // Of those that intersect now, the ones that did not at x0; of neighbours folded now, the ones whose fold went through.
     passing.clear();
     for (std::size_t i = 0; i < tests.size(); ++i) {
       if (!hits[i]) continue;
       const auto s = static_cast<std::uint32_t>(tests[i] >> 32), t = static_cast<std::uint32_t>(tests[i]);
       make(at0, x0_, s);
       make(at0, x0_, t);
-      if (!through(made0_[slot0_[s]], made0_[slot0_[t]])) passing.push_back({s, t});
+      const bool now = through(madeX_[slotX_[s]], madeX_[slotX_[t]]);
+      if (now ? !through(made0_[slot0_[s]], made0_[slot0_[t]]) : wrapped(s, t)) passing.push_back({s, t});
     }
     // Before ending: every pair that passed in an earlier round, tested again as the particles
     // are now. A round's move may leave a pair that still passes where it is (its corners in a
@@ -910,7 +952,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
       for (const auto& [s, t] : everPassing) {
         make(atX, x_, s);
         make(atX, x_, t);
-        if (through(madeX_[slotX_[s]], madeX_[slotX_[t]])) passing.push_back({s, t});
+        if (through(madeX_[slotX_[s]], madeX_[slotX_[t]]) || wrapped(s, t)) passing.push_back({s, t});
       }
       if (passing.empty()) break;
       verifying = true;

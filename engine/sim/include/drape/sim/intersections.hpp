@@ -9,8 +9,10 @@
 // Which pairs: every two triangles of the world (of one cloth or of two) that share no particle and
 // whose closed triangles have a point in common; and two of one cloth that share one particle when
 // the edge of one opposite it passes through the other (a fold through a vertex). Two triangles
-// that share an edge are never counted. A flat sheet has none; two sheets crossing like the pages of
-// a half-open book have one pair per pair of triangles along the crossing line.
+// that share an edge are counted only when one lies folded flat onto the other: their other corners
+// in one plane with the edge and on one side of it there (a triangle turned over on a table, onto
+// its neighbour). A flat sheet has none; two sheets crossing like the pages of a half-open book
+// have one pair per pair of triangles along the crossing line.
 #pragma once
 
 #include <cstddef>
