@@ -8,7 +8,7 @@
 //                byte 3 the constraint kinds (bits 0-2: stretch, shear, bend; 0 is taken as all).
 //   the rest: points (x, z) as pairs: raw doubles (16 bytes a point); 16-bit integers times
 //             spacing * 2^(e/2 - 8); 8-bit integers times spacing * 2^(e/4 - 3).
-// A stroke that could fill more than 3000 particles (fuzz_support.hpp) is skipped (slow, not
+// A stroke that could fill more than 400 particles (fuzz_support.hpp) is skipped (slow, not
 // hostile), unless its numbers are not finite, which the builder must refuse at once.
 //
 // Checked of a cloth it builds: every index names a particle it has, every position and rest
