@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -134,8 +135,82 @@ SpinResult spin(const SpinSpec& spec) {
   return result;
 }
 
+namespace {
+
+// The drawn strip (CantileverSpec::drawn): a rectangle along `along`, from three spacings back over
+// the platform to the overhang, its particles on the platform pinned.
+CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::steady_clock::time_point started) {
+  constexpr double kHeight = 0.5;
+  const sim::Vec3 along{std::cos(spec.angle), 0.0, std::sin(spec.angle)}, across{-along.z, 0.0, along.x};
+  // The lattice's nodes where the strip's corners are not: its sides cut through the cells.
+  const sim::Vec3 origin{0.3 * spec.spacing, kHeight, 0.45 * spec.spacing};
+  const auto at = [&](double a, double b) { return origin + along * a + across * b; };
+  sim::WorldSettings settings = labWorld(spec);
+  sim::ClothSettings cloth;
+  sim::OutlineSpec outline;
+  outline.spacing = spec.spacing;
+  outline.height = kHeight;
+  const double back = -3.0 * spec.spacing;
+  for (const auto& [a, b] : {std::pair{back, 0.0}, {spec.overhang, 0.0}, {spec.overhang, spec.width}, {back, spec.width}}) {
+    const sim::Vec3 corner = at(a, b);
+    outline.points.push_back({corner.x, corner.z});
+  }
+  cloth.outline = outline;
+  cloth.fabric = spec.fabric;
+  settings.cloths.push_back(cloth);
+  sim::World world(settings);
+  std::vector<sim::Cloth> cloths = world.cloths();
+  sim::ParticleState& state = cloths[0].state;
+  const sim::Vec3 tipCorners[2] = {at(spec.overhang, 0.0), at(spec.overhang, spec.width)};
+  std::size_t tip[2] = {0, 0};
+  for (std::size_t i = 0; i < state.position.size(); ++i) {
+    const sim::Vec3 x = cloths[0].rest.restPosition(i);
+    if (glm::dot(x - origin, along) <= 1e-9) {
+      state.pinned[i] = 1;
+      state.inverseMass[i] = 0.0;
+    }
+    for (int k = 0; k < 2; ++k) {
+      const sim::Vec3 best = cloths[0].rest.restPosition(tip[k]);
+      if (glm::length(x - tipCorners[k]) < glm::length(best - tipCorners[k])) tip[k] = i;
+    }
+  }
+  world.restoreCloths(std::move(cloths));
+
+  CantileverResult result;
+  result.overhang = spec.overhang;
+  result.expected = bendingLength(spec.fabric, 9.81);
+  result.expectedAngle = elasticaChordAngle(result.overhang / result.expected);
+  const sim::Vec3 root = at(0.0, 0.5 * spec.width);
+  const auto tipNow = [&] {
+    const sim::Cloth& c = world.cloths()[0];
+    return 0.5 * (c.state.position[tip[0]] + c.state.position[tip[1]]);
+  };
+  const auto frames = static_cast<std::int64_t>(std::ceil(spec.settle / settings.solver.dt));
+  if (world.run(frames - 1) != sim::StepStatus::ok) {
+    result.diverged = true;
+    return result;
+  }
+  const sim::Vec3 before = tipNow();
+  result.diverged = world.step() != sim::StepStatus::ok;
+  const sim::Vec3 end = tipNow();
+  result.tipMotion = glm::length(end - before);
+  result.chordAngle = std::atan2(root.y - end.y, glm::dot(end - root, along));
+  result.bendingLength = elasticaBendingLength(result.overhang, result.chordAngle);
+  result.peirce = peirceBendingLength(result.overhang, result.chordAngle);
+  const sim::Cloth& c = world.cloths()[0];
+  for (const sim::DistanceConstraint& link : c.rest.of(sim::ConstraintKind::stretch)) {
+    const double length = glm::length(c.state.position[link.b] - c.state.position[link.a]);
+    result.maxStrain = std::max(result.maxStrain, length / link.restLength - 1.0);
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+}  // namespace
+
 CantileverResult cantilever(const CantileverSpec& spec) {
   const auto started = std::chrono::steady_clock::now();
+  if (spec.drawn) return drawnCantilever(spec, started);
   const int free = std::max(1, static_cast<int>(std::lround(spec.overhang / spec.spacing - 0.5)));
   const int across = std::max(1, static_cast<int>(std::lround(spec.width / spec.spacing)));
   sim::WorldSettings settings = labWorld(spec);

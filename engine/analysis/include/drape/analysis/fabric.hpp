@@ -32,6 +32,11 @@ struct CantileverSpec {
   bool lines = false;    // the stretch links a line at a time (sim::SolverSettings::lines), not one by one
   double settle = 5.0;   // s of simulated time, damped, before it is read
   double damping = 4.0;  // 1/s (global: it slows the strip, it does not change where it comes to rest)
+  // A drawn strip (sim::OutlineSpec) instead of a lattice: a rectangle `angle` (radians) off the
+  // fill's lattice lines, its overhang and width as given (not rounded), its bend stencils those an
+  // outline cloth gets (a clipped border, lines at `angle` to the strip).
+  bool drawn = false;
+  double angle = 0.0;
 };
 
 struct CantileverResult {
@@ -48,7 +53,9 @@ struct CantileverResult {
 };
 
 // The strip, lying along +x with its first two columns pinned (the platform, whose edge is halfway
-// between them), left to settle under gravity. The overhang is from that edge to the tip.
+// between them), left to settle under gravity. The overhang is from that edge to the tip. Drawn:
+// three spacings of the strip lie on the platform, every particle not beyond its edge pinned, and
+// the chord runs from the edge's middle to the middle of the tip's two corners.
 CantileverResult cantilever(const CantileverSpec& spec);
 
 // The Cusick drape test (BS 5058, ISO 9073-9): a disc of fabric clamped between two smaller discs
