@@ -137,6 +137,19 @@ SpinResult spin(const SpinSpec& spec) {
 
 namespace {
 
+// What a cantilever reads once its chord's angle is in: the bending lengths, the worst strain, the time.
+void finishCantilever(CantileverResult& result, const sim::World& world,
+                      const std::chrono::steady_clock::time_point started) {
+  result.bendingLength = elasticaBendingLength(result.overhang, result.chordAngle);
+  result.peirce = peirceBendingLength(result.overhang, result.chordAngle);
+  const sim::Cloth& c = world.cloths()[0];
+  for (const sim::DistanceConstraint& link : c.rest.of(sim::ConstraintKind::stretch)) {
+    const double length = glm::length(c.state.position[link.b] - c.state.position[link.a]);
+    result.maxStrain = std::max(result.maxStrain, length / link.restLength - 1.0);
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
 // The drawn strip (CantileverSpec::drawn): a rectangle along `along`, from three spacings back over
 // the platform to the overhang, its particles on the platform pinned.
 CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::steady_clock::time_point started) {
@@ -151,7 +164,8 @@ CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::
   outline.spacing = spec.spacing;
   outline.height = kHeight;
   const double back = -3.0 * spec.spacing;
-  for (const auto& [a, b] : {std::pair{back, 0.0}, {spec.overhang, 0.0}, {spec.overhang, spec.width}, {back, spec.width}}) {
+  for (const auto& [a, b] :
+       {std::pair{back, 0.0}, {spec.overhang, 0.0}, {spec.overhang, spec.width}, {back, spec.width}}) {
     const sim::Vec3 corner = at(a, b);
     outline.points.push_back({corner.x, corner.z});
   }
@@ -195,14 +209,7 @@ CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::
   const sim::Vec3 end = tipNow();
   result.tipMotion = glm::length(end - before);
   result.chordAngle = std::atan2(root.y - end.y, glm::dot(end - root, along));
-  result.bendingLength = elasticaBendingLength(result.overhang, result.chordAngle);
-  result.peirce = peirceBendingLength(result.overhang, result.chordAngle);
-  const sim::Cloth& c = world.cloths()[0];
-  for (const sim::DistanceConstraint& link : c.rest.of(sim::ConstraintKind::stretch)) {
-    const double length = glm::length(c.state.position[link.b] - c.state.position[link.a]);
-    result.maxStrain = std::max(result.maxStrain, length / link.restLength - 1.0);
-  }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  finishCantilever(result, world, started);
   return result;
 }
 
@@ -256,14 +263,7 @@ CantileverResult cantilever(const CantileverSpec& spec) {
   const auto [root, end] = tip();
   result.tipMotion = glm::length(end - before);
   result.chordAngle = std::atan2(root.y - end.y, end.x - root.x);
-  result.bendingLength = elasticaBendingLength(result.overhang, result.chordAngle);
-  result.peirce = peirceBendingLength(result.overhang, result.chordAngle);
-  const sim::Cloth& c = world.cloths()[0];
-  for (const sim::DistanceConstraint& link : c.rest.of(sim::ConstraintKind::stretch)) {
-    const double length = glm::length(c.state.position[link.b] - c.state.position[link.a]);
-    result.maxStrain = std::max(result.maxStrain, length / link.restLength - 1.0);
-  }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  finishCantilever(result, world, started);
   return result;
 }
 
