@@ -244,7 +244,6 @@ TEST(Cantilever, ADrawnStripAlongTheLatticeComesCloserToTheElasticaAsItsMeshIsRe
     const CantileverResult r = cantilever(spec);
     ASSERT_FALSE(r.diverged);
     EXPECT_LT(r.tipMotion, 1e-5) << "still moving";
-    EXPECT_DOUBLE_EQ(r.overhang, spec.overhang);
     const double now = std::abs(r.bendingLength / r.expected - 1.0);
     EXPECT_LT(now, 0.75 * error) << spacing;
     error = now;

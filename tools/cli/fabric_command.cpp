@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
-#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -331,11 +330,11 @@ int fabric(const FabricArguments& arguments) {
               "error | tip motion (mm) | worst strain | run (s) |\n"
            << "|---|---|---|---|---|---|---|---|---|---|\n";
     int drawnWithin = 0, drawnRuns = 0;
-    const std::optional<sim::Fabric> denim = scene::fabricPreset("denim");
+    const sim::Fabric denim = scene::fabricPreset("denim").value();
     for (double spacing : kSpacings) {
       for (const double angle : {0.0, 15.0, 30.0, 45.0}) {
         analysis::CantileverSpec spec;
-        spec.fabric = *denim;
+        spec.fabric = denim;
         spec.spacing = spacing;
         spec.overhang = 2.0 * analysis::bendingLength(spec.fabric);
         spec.substeps = 10;

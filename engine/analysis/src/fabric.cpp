@@ -94,6 +94,13 @@ sim::WorldSettings labWorld(const Spec& spec) {
   return settings;
 }
 
+// Runs all but the last frame of `seconds` (the caller steps the last one, to see what still
+// moves); false if the world diverged on the way.
+bool settleToLastFrame(sim::World& world, double seconds) {
+  const auto frames = static_cast<std::int64_t>(std::ceil(seconds / world.settings().solver.dt));
+  return world.run(frames - 1) == sim::StepStatus::ok;
+}
+
 }  // namespace
 
 SpinResult spin(const SpinSpec& spec) {
@@ -199,8 +206,7 @@ CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::
     const sim::Cloth& c = world.cloths()[0];
     return 0.5 * (c.state.position[tip[0]] + c.state.position[tip[1]]);
   };
-  const auto frames = static_cast<std::int64_t>(std::ceil(spec.settle / settings.solver.dt));
-  if (world.run(frames - 1) != sim::StepStatus::ok) {
+  if (!settleToLastFrame(world, spec.settle)) {
     result.diverged = true;
     return result;
   }
@@ -253,8 +259,7 @@ CantileverResult cantilever(const CantileverSpec& spec) {
     }
     return std::pair{root / static_cast<double>(across + 1), end / static_cast<double>(across + 1)};
   };
-  const auto frames = static_cast<std::int64_t>(std::ceil(spec.settle / settings.solver.dt));
-  if (world.run(frames - 1) != sim::StepStatus::ok) {
+  if (!settleToLastFrame(world, spec.settle)) {
     result.diverged = true;
     return result;
   }
@@ -309,8 +314,7 @@ CusickResult cusick(const CusickSpec& spec) {
 
   CusickResult result;
   result.particles = static_cast<int>(world.cloths()[0].state.position.size());
-  const auto frames = static_cast<std::int64_t>(std::ceil(spec.settle / settings.solver.dt));
-  if (world.run(frames - 1) != sim::StepStatus::ok) {
+  if (!settleToLastFrame(world, spec.settle)) {
     result.diverged = true;
     return result;
   }
