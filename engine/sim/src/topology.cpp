@@ -372,6 +372,12 @@ namespace {
 // spacings), and a particle on the line is moved along one of its edges onto the plane (by at most
 // kOnLine spacings, and at most a quarter of its shortest edge, so none of its triangles folds over).
 constexpr Real kOnLine = 0.3;
+// Two crossings of one triangle closer than this many spacings share a particle (openAlong).
+constexpr Real kMergeChord = 0.2;
+// Tries at sharing before every crossing keeps its own particle.
+constexpr int kMergeAttempts = 4;
+// A child a shared particle makes needs at least this many spacings squared of doubled area.
+constexpr Real kLeastChildArea = 1e-3;
 
 Real restEdge(const ClothRest& rest, ParticleIndex a, ParticleIndex b) {
   return glm::length(rest.restPosition(b) - rest.restPosition(a));
@@ -405,6 +411,19 @@ ParticleIndex insertParticle(Cloth& cloth, ParticleIndex a, ParticleIndex b, Rea
   st.inverseMass.push_back(pinned ? 0.0 : 1.0);
   st.pinned.push_back(pinned ? 1 : 0);
   return p;
+}
+
+// Takes the particles from `count` on away again (made by insertParticle, their masses not set yet).
+void truncateParticles(Cloth& cloth, std::size_t count) {
+  ClothRest& rest = cloth.rest;
+  ParticleState& st = cloth.state;
+  rest.restOffsets.resize(count);
+  st.position.resize(count);
+  st.previousPosition.resize(count);
+  if (!st.velocity.empty()) st.velocity.resize(count);
+  st.mass.resize(count);
+  st.inverseMass.resize(count);
+  st.pinned.resize(count);
 }
 
 // A triangle a cut splits: its corners and neighbours before, and what it became.
@@ -444,6 +463,7 @@ struct Line {
 struct Opening {
   std::vector<ParticleIndex> touched;  // ends of severed edges
   std::vector<ParticleIndex> moved;    // particles moved onto a line
+  std::size_t firstNew = 0;            // the first particle the openings made
   bool changed = false;
 };
 
@@ -516,88 +536,199 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
          ++t)
       topology.triangleArea[*t] = triangleArea(rest, rest.triangles[*t]);
   }
-  for (auto& [edge, particle] : crossing) {
-    const auto p = static_cast<ParticleIndex>(edge >> 32), q = static_cast<ParticleIndex>(edge & 0xffffffffu);
-    const Real at = crossingAt(p, q);
-    particle = insertParticle(cloth, p, q, at);
-    inserted.push_back({p, q, at, particle});
-  }
-  particleBudget -= crossing.size();
-  const auto pointOn = [&](ParticleIndex p, ParticleIndex q) -> std::int64_t {
+  // Where the plane clips a corner of a small triangle (one an earlier cut left), its two
+  // crossings lie close together and the corner's child would be a sliver: two crossings of one
+  // triangle closer than kMergeChord spacings at rest share one particle, halfway between them (on
+  // the plane still, and off each edge by at most half that). The triangle then loses the corner's
+  // child, which its neighbours across the two edges cover, and the cut passes through the shared
+  // particle. Where that would turn a triangle over (a neighbour thin enough), the two stay apart.
+  const auto crossingIndex = [&](ParticleIndex p, ParticleIndex q) -> std::int64_t {
     const auto found = std::lower_bound(crossing.begin(), crossing.end(), std::pair{key(p, q), ParticleIndex{0}});
-    return found != crossing.end() && found->first == key(p, q) ? static_cast<std::int64_t>(found->second) : -1;
+    return found != crossing.end() && found->first == key(p, q) ? found - crossing.begin() : -1;
   };
-  // Split every triangle with a new particle on an edge; note the cut's edges.
+  const auto crossingRest = [&](std::size_t k) {
+    const auto p = static_cast<ParticleIndex>(crossing[k].first >> 32);
+    const auto q = static_cast<ParticleIndex>(crossing[k].first & 0xffffffffu);
+    return glm::mix(rest.restPosition(p), rest.restPosition(q), crossingAt(p, q));
+  };
+  const auto pointOn = [&](ParticleIndex p, ParticleIndex q) -> std::int64_t {
+    const std::int64_t k = crossingIndex(p, q);
+    return k >= 0 ? static_cast<std::int64_t>(crossing[static_cast<std::size_t>(k)].second) : -1;
+  };
+  const Real mergeChord = kMergeChord * topology.spacing;
+  std::vector<std::uint8_t> apart(crossing.size(), 0);  // crossings that keep a particle each
+  std::vector<std::int64_t> partner(crossing.size());
+  std::vector<std::size_t> crossingOf;  // per new particle, the (first) crossing it stands for
   std::vector<Split> split;
   struct OnEdge {  // an edge of the mesh as it was that lies on the cut: both ends on it
     std::uint32_t triangle;
     int edge;
   };
   std::vector<OnEdge> onEdge;
-  for (std::uint32_t t = 0; t < t0; ++t) {
-    const Triangle c = rest.triangles[t];
-    std::array<std::int64_t, 3> x{};
-    int count = 0;
-    for (int k = 0; k < 3; ++k) {
-      x[static_cast<std::size_t>(k)] = pointOn(c[k], c[(k + 1) % 3]);
-      if (x[static_cast<std::size_t>(k)] >= 0) ++count;
+  for (int attempt = 0;; ++attempt) {
+    std::fill(partner.begin(), partner.end(), -1);
+    if (attempt < kMergeAttempts) {
+      for (std::uint32_t t = 0; t < t0; ++t) {
+        const Triangle c = rest.triangles[t];
+        for (int k = 0; k < 3; ++k) {
+          const std::int64_t a = crossingIndex(c[k], c[(k + 1) % 3]), b = crossingIndex(c[(k + 1) % 3], c[(k + 2) % 3]);
+          if (a < 0 || b < 0) continue;
+          const auto ua = static_cast<std::size_t>(a), ub = static_cast<std::size_t>(b);
+          if (partner[ua] >= 0 || partner[ub] >= 0 || apart[ua] || apart[ub]) continue;
+          if (!(glm::length(crossingRest(ua) - crossingRest(ub)) < mergeChord)) continue;
+          partner[ua] = b;
+          partner[ub] = a;
+        }
+      }
     }
-    if (count == 0) {
+    // The new particles: one per crossing, or one per two that share.
+    std::size_t made = 0;
+    crossingOf.clear();
+    for (std::size_t k = 0; k < crossing.size(); ++k) {
+      const std::int64_t other = partner[k];
+      if (other >= 0 && static_cast<std::size_t>(other) < k) {
+        crossing[k].second = crossing[static_cast<std::size_t>(other)].second;
+        continue;
+      }
+      const auto p = static_cast<ParticleIndex>(crossing[k].first >> 32);
+      const auto q = static_cast<ParticleIndex>(crossing[k].first & 0xffffffffu);
+      const Real at = crossingAt(p, q);
+      const ParticleIndex particle = insertParticle(cloth, p, q, at);
+      crossing[k].second = particle;
+      inserted.push_back({p, q, at, particle});
+      crossingOf.push_back(k);
+      ++made;
+      if (other < 0) continue;
+      // Halfway to the partner's crossing, at rest and now.
+      const auto o = static_cast<std::size_t>(other);
+      const auto p2 = static_cast<ParticleIndex>(crossing[o].first >> 32);
+      const auto q2 = static_cast<ParticleIndex>(crossing[o].first & 0xffffffffu);
+      const Real at2 = crossingAt(p2, q2);
+      const glm::vec3 offset2 =
+          rest.restOffsets[p2] + static_cast<float>(at2) * (rest.restOffsets[q2] - rest.restOffsets[p2]);
+      rest.restOffsets[particle] = 0.5f * (rest.restOffsets[particle] + offset2);
+      s.position[particle] = 0.5 * (s.position[particle] + glm::mix(s.position[p2], s.position[q2], at2));
+      s.previousPosition[particle] =
+          0.5 * (s.previousPosition[particle] + glm::mix(s.previousPosition[p2], s.previousPosition[q2], at2));
+      if (!s.velocity.empty())
+        s.velocity[particle] = 0.5 * (s.velocity[particle] + glm::mix(s.velocity[p2], s.velocity[q2], at2));
+      if (s.pinned[particle] != (s.pinned[p2] && s.pinned[q2] ? 1 : 0)) {
+        s.pinned[particle] = 0;
+        s.inverseMass[particle] = 1.0;
+      }
+    }
+    // Split every triangle with a new particle on an edge; note the cut's edges.
+    split.clear();
+    onEdge.clear();
+    for (std::uint32_t t = 0; t < t0; ++t) {
+      const Triangle c = rest.triangles[t];
+      std::array<std::int64_t, 3> x{};
+      int count = 0;
       for (int k = 0; k < 3; ++k) {
-        if (onCut(c[k]) && onCut(c[(k + 1) % 3]) && side[c[(k + 2) % 3]] != 0) onEdge.push_back({t, k});
+        x[static_cast<std::size_t>(k)] = pointOn(c[k], c[(k + 1) % 3]);
+        if (x[static_cast<std::size_t>(k)] >= 0) ++count;
       }
-      continue;
-    }
-    Split sp;
-    sp.parent = t;
-    sp.corners = c;
-    sp.neighbour = topology.neighbour[t];
-    using F = std::array<std::int8_t, 3>;
-    if (count == 2) {
-      // Edges i and i + 1 cut: corner i + 1 is alone on its side.
-      int i = 0;
-      while (!(x[static_cast<std::size_t>(i)] >= 0 && x[static_cast<std::size_t>((i + 1) % 3)] >= 0)) ++i;
-      const int j = (i + 1) % 3, m = (i + 2) % 3;
-      const auto xi = static_cast<ParticleIndex>(x[static_cast<std::size_t>(i)]);
-      const auto xj = static_cast<ParticleIndex>(x[static_cast<std::size_t>(j)]);
-      const ParticleIndex lone = c[j], next = c[m], first = c[i];
-      sp.children.push_back({Triangle(xi, lone, xj), F{static_cast<std::int8_t>(i), static_cast<std::int8_t>(j), -1}});
-      // The rest, a quad xj next first xi, along whichever diagonal leaves the larger smallest angle.
-      const Real viaFirst = std::min(smallestAngle(rest, xj, next, first), smallestAngle(rest, xj, first, xi));
-      const Real viaNext = std::min(smallestAngle(rest, xj, next, xi), smallestAngle(rest, next, first, xi));
-      if (viaFirst >= viaNext) {
+      if (count == 0) {
+        for (int k = 0; k < 3; ++k) {
+          if (onCut(c[k]) && onCut(c[(k + 1) % 3]) && side[c[(k + 2) % 3]] != 0) onEdge.push_back({t, k});
+        }
+        continue;
+      }
+      Split sp;
+      sp.parent = t;
+      sp.corners = c;
+      sp.neighbour = topology.neighbour[t];
+      using F = std::array<std::int8_t, 3>;
+      if (count == 2) {
+        // Edges i and i + 1 cut: corner i + 1 is alone on its side.
+        int i = 0;
+        while (!(x[static_cast<std::size_t>(i)] >= 0 && x[static_cast<std::size_t>((i + 1) % 3)] >= 0)) ++i;
+        const int j = (i + 1) % 3, m = (i + 2) % 3;
+        const auto xi = static_cast<ParticleIndex>(x[static_cast<std::size_t>(i)]);
+        const auto xj = static_cast<ParticleIndex>(x[static_cast<std::size_t>(j)]);
+        const ParticleIndex lone = c[j], next = c[m], first = c[i];
+        if (xi == xj) {
+          // The two crossings share a particle: the corner's child is gone, the quad a triangle.
+          sp.children.push_back({Triangle(xj, next, first), F{static_cast<std::int8_t>(j), static_cast<std::int8_t>(m),
+                                                              static_cast<std::int8_t>(i)}});
+          split.push_back(std::move(sp));
+          continue;
+        }
         sp.children.push_back(
-            {Triangle(xj, next, first), F{static_cast<std::int8_t>(j), static_cast<std::int8_t>(m), -1}});
-        sp.children.push_back({Triangle(xj, first, xi), F{-1, static_cast<std::int8_t>(i), -1}});
-        sp.cutEdgeChild = 2;
-        sp.cutEdge = 2;
+            {Triangle(xi, lone, xj), F{static_cast<std::int8_t>(i), static_cast<std::int8_t>(j), -1}});
+        // The rest, a quad xj next first xi, along whichever diagonal leaves the larger smallest angle.
+        const Real viaFirst = std::min(smallestAngle(rest, xj, next, first), smallestAngle(rest, xj, first, xi));
+        const Real viaNext = std::min(smallestAngle(rest, xj, next, xi), smallestAngle(rest, next, first, xi));
+        if (viaFirst >= viaNext) {
+          sp.children.push_back(
+              {Triangle(xj, next, first), F{static_cast<std::int8_t>(j), static_cast<std::int8_t>(m), -1}});
+          sp.children.push_back({Triangle(xj, first, xi), F{-1, static_cast<std::int8_t>(i), -1}});
+          sp.cutEdgeChild = 2;
+          sp.cutEdge = 2;
+        } else {
+          sp.children.push_back({Triangle(xj, next, xi), F{static_cast<std::int8_t>(j), -1, -1}});
+          sp.children.push_back(
+              {Triangle(next, first, xi), F{static_cast<std::int8_t>(m), static_cast<std::int8_t>(i), -1}});
+          sp.cutEdgeChild = 1;
+          sp.cutEdge = 2;
+        }
+      } else if (count == 1) {
+        int i = 0;
+        while (x[static_cast<std::size_t>(i)] < 0) ++i;
+        const int j = (i + 1) % 3, m = (i + 2) % 3;
+        const auto xi = static_cast<ParticleIndex>(x[static_cast<std::size_t>(i)]);
+        const ParticleIndex opposite = c[m];
+        sp.children.push_back(
+            {Triangle(c[i], xi, opposite), F{static_cast<std::int8_t>(i), -1, static_cast<std::int8_t>(m)}});
+        sp.children.push_back(
+            {Triangle(xi, c[j], opposite), F{static_cast<std::int8_t>(i), static_cast<std::int8_t>(j), -1}});
+        // The cut runs on to the opposite corner where that is on the cut (or where the last segment
+        // left it); else the swipe ends (or starts) inside this triangle, at xi.
+        if (onCut(opposite) || (opposite < n0 && line.joins[opposite])) {
+          sp.cutEdgeChild = 0;
+          sp.cutEdge = 1;
+        }
       } else {
-        sp.children.push_back({Triangle(xj, next, xi), F{static_cast<std::int8_t>(j), -1, -1}});
-        sp.children.push_back(
-            {Triangle(next, first, xi), F{static_cast<std::int8_t>(m), static_cast<std::int8_t>(i), -1}});
-        sp.cutEdgeChild = 1;
-        sp.cutEdge = 2;
+        continue;  // three: cannot happen (a plane crosses at most two edges of a triangle)
       }
-    } else if (count == 1) {
-      int i = 0;
-      while (x[static_cast<std::size_t>(i)] < 0) ++i;
-      const int j = (i + 1) % 3, m = (i + 2) % 3;
-      const auto xi = static_cast<ParticleIndex>(x[static_cast<std::size_t>(i)]);
-      const ParticleIndex opposite = c[m];
-      sp.children.push_back(
-          {Triangle(c[i], xi, opposite), F{static_cast<std::int8_t>(i), -1, static_cast<std::int8_t>(m)}});
-      sp.children.push_back(
-          {Triangle(xi, c[j], opposite), F{static_cast<std::int8_t>(i), static_cast<std::int8_t>(j), -1}});
-      // The cut runs on to the opposite corner where that is on the cut (or where the last segment
-      // left it); else the swipe ends (or starts) inside this triangle, at xi.
-      if (onCut(opposite) || (opposite < n0 && line.joins[opposite])) {
-        sp.cutEdgeChild = 0;
-        sp.cutEdge = 1;
-      }
-    } else {
-      continue;  // three: cannot happen (a plane crosses at most two edges of a triangle)
+      split.push_back(std::move(sp));
     }
-    split.push_back(std::move(sp));
+    // A shared particle off the edges it stands for must leave every child facing the way its
+    // parent did, with an area; where one does not, its two crossings stay apart and all is made again.
+    bool turned = false;
+    for (const Split& sp : split) {
+      const Triangle& c = sp.corners;
+      const Vec3 facing = glm::cross(rest.restPosition(c[1]) - rest.restPosition(c[0]),
+                                     rest.restPosition(c[2]) - rest.restPosition(c[0]));
+      const Real size = glm::length(facing);
+      for (const Split::Child& child : sp.children) {
+        bool shared = false;
+        for (int k = 0; k < 3; ++k) {
+          const ParticleIndex p = child.corners[k];
+          if (p < n0) continue;
+          const std::size_t at = crossingOf[p - n0];
+          if (partner[at] >= 0) shared = true;
+        }
+        if (!shared) continue;
+        const Vec3 n = glm::cross(rest.restPosition(child.corners[1]) - rest.restPosition(child.corners[0]),
+                                  rest.restPosition(child.corners[2]) - rest.restPosition(child.corners[0]));
+        if (glm::dot(n, facing) > kLeastChildArea * size * topology.spacing * topology.spacing) continue;
+        for (int k = 0; k < 3; ++k) {
+          const ParticleIndex p = child.corners[k];
+          if (p < n0) continue;
+          const std::size_t at = crossingOf[p - n0];
+          if (partner[at] < 0) continue;
+          apart[at] = apart[static_cast<std::size_t>(partner[at])] = 1;
+          turned = true;
+        }
+      }
+    }
+    if (!turned) {
+      particleBudget -= made;
+      break;
+    }
+    truncateParticles(cloth, n0);
+    inserted.resize(insertedBefore);
   }
   // The constraints the split triangles witness, as particle pairs, to be found again in their children.
   std::vector<std::uint8_t> isParent(t0, 0);
@@ -747,13 +878,144 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
   }
 }
 
+// The smallest angle a flip must lift the pair's smallest angle past, and by how much (radians).
+constexpr Real kFlipBelow = 25.0 * 3.14159265358979323846 / 180.0;
+constexpr Real kFlipGain = 1e-3;
+constexpr int kFlipPasses = 8;
+// A quad flips only where it lies flat now: its two triangles' normals within this cosine.
+constexpr Real kFlipFlat = 0.996;  // about 5 degrees
+
+// Flips the edges between the triangles around `around` (and one ring beyond) where the other
+// diagonal of their quad gives a larger smallest angle at rest (the max-min rule that leads to a
+// Delaunay mesh), so that slivers a cut or tear leaves beside its border (two cuts meeting at a
+// small angle, a snapped particle) become fair triangles where the mesh around allows. Only edges
+// still joined flip, so the border stays where the cuts put it; only quads convex at rest and
+// flat now (the surface does not change shape), so no triangle turns over. The stretch link along
+// the edge moves to the new one; a shear link on the new one (a lattice's other diagonal) moves to
+// the old.
+void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
+  ClothRest& rest = cloth.rest;
+  Topology& topology = cloth.topology;
+  const std::vector<Vec3>& x = cloth.state.position;
+  const std::size_t n = rest.particleCount();
+  std::vector<std::uint8_t> near(n, 0);
+  for (const ParticleIndex p : around) {
+    if (p < n) near[p] = 1;
+  }
+  const auto normal = [&](auto&& at, ParticleIndex a, ParticleIndex b, ParticleIndex c) {
+    return glm::cross(at(b) - at(a), at(c) - at(a));
+  };
+  const auto restAt = [&](ParticleIndex p) { return rest.restPosition(p); };
+  const auto nowAt = [&](ParticleIndex p) { return x[p]; };
+  const auto unit = [](Vec3 v) {
+    const Real l = glm::length(v);
+    return l > 0.0 ? v / l : Vec3{0.0};
+  };
+  for (int pass = 0; pass < kFlipPasses; ++pass) {
+    const Incidence incidence(rest.triangles, n);
+    std::vector<std::uint32_t> candidates;
+    for (std::size_t p = 0; p < n; ++p) {
+      if (!near[p]) continue;
+      for (auto t = incidence.begin(static_cast<ParticleIndex>(p)); t != incidence.end(static_cast<ParticleIndex>(p));
+           ++t) {
+        candidates.push_back(*t);
+        for (const std::int32_t o : topology.neighbour[*t]) {
+          if (o >= 0) candidates.push_back(static_cast<std::uint32_t>(o));
+        }
+      }
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    std::vector<std::uint8_t> changed(n, 0);  // corners of a flip this pass (their incidence is stale)
+    bool flipped = false;
+    for (const std::uint32_t t : candidates) {
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t other = topology.neighbour[t][static_cast<std::size_t>(k)];
+        if (other < 0 || static_cast<std::uint32_t>(other) < t) continue;
+        const auto o = static_cast<std::uint32_t>(other);
+        const Triangle tt = rest.triangles[t], to = rest.triangles[o];
+        const ParticleIndex a = tt[k], b = tt[(k + 1) % 3], c = tt[(k + 2) % 3];
+        int ko = 0;
+        while (ko < 3 && !(to[ko] == b && to[(ko + 1) % 3] == a)) ++ko;
+        if (ko == 3) continue;  // joined the other way round: leave it
+        const ParticleIndex d = to[(ko + 2) % 3];
+        if (c == d || changed[a] || changed[b] || changed[c] || changed[d]) continue;
+        const Real before = std::min(smallestAngle(rest, a, b, c), smallestAngle(rest, b, a, d));
+        if (!(before < kFlipBelow)) continue;
+        const Real after = std::min(smallestAngle(rest, a, d, c), smallestAngle(rest, d, b, c));
+        if (!(after > before + kFlipGain)) continue;
+        // Convex at rest: the new triangles face as the old did.
+        const Vec3 facing = normal(restAt, a, b, c) + normal(restAt, b, a, d);
+        if (!(glm::dot(normal(restAt, a, d, c), facing) > 0.0) || !(glm::dot(normal(restAt, d, b, c), facing) > 0.0))
+          continue;
+        // Flat and convex now.
+        const Vec3 nt = unit(normal(nowAt, a, b, c)), no = unit(normal(nowAt, b, a, d));
+        if (!(glm::dot(nt, no) > kFlipFlat) || !(glm::dot(unit(normal(nowAt, a, d, c)), nt + no) > 0.0) ||
+            !(glm::dot(unit(normal(nowAt, d, b, c)), nt + no) > 0.0))
+          continue;
+        // Not an edge already (a triangle elsewhere with both c and d).
+        bool taken = false;
+        for (auto u = incidence.begin(c); u != incidence.end(c) && !taken; ++u)
+          taken = cornerOf(rest.triangles[*u], d) >= 0;
+        if (taken) continue;
+        // t becomes (a, d, c) and o (d, b, c).
+        const std::array<std::int32_t, 3> oldT = topology.neighbour[t], oldO = topology.neighbour[o];
+        rest.triangles[t] = Triangle(a, d, c);
+        rest.triangles[o] = Triangle(d, b, c);
+        const std::int32_t acrossAD = oldO[static_cast<std::size_t>((ko + 1) % 3)];
+        const std::int32_t acrossBC = oldT[static_cast<std::size_t>((k + 1) % 3)];
+        topology.neighbour[t] = {acrossAD, static_cast<std::int32_t>(o), oldT[static_cast<std::size_t>((k + 2) % 3)]};
+        topology.neighbour[o] = {oldO[static_cast<std::size_t>((ko + 2) % 3)], acrossBC, static_cast<std::int32_t>(t)};
+        if (acrossAD >= 0) {
+          for (std::int32_t& back : topology.neighbour[static_cast<std::size_t>(acrossAD)]) {
+            if (back == static_cast<std::int32_t>(o)) back = static_cast<std::int32_t>(t);
+          }
+        }
+        if (acrossBC >= 0) {
+          for (std::int32_t& back : topology.neighbour[static_cast<std::size_t>(acrossBC)]) {
+            if (back == static_cast<std::int32_t>(t)) back = static_cast<std::int32_t>(o);
+          }
+        }
+        topology.triangleArea[t] = triangleArea(rest, rest.triangles[t]);
+        topology.triangleArea[o] = triangleArea(rest, rest.triangles[o]);
+        // The links: stretch from a-b to c-d, a shear on c-d to a-b.
+        const auto same = [](const DistanceConstraint& l, ParticleIndex p, ParticleIndex q) {
+          return (l.a == p && l.b == q) || (l.a == q && l.b == p);
+        };
+        auto& stretch = rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
+        auto& shear = rest.constraints[static_cast<std::size_t>(ConstraintKind::shear)];
+        const bool hasCD = std::any_of(stretch.begin(), stretch.end(), [&](const auto& l) { return same(l, c, d); });
+        for (std::size_t j = 0; j < stretch.size(); ++j) {
+          if (!same(stretch[j], a, b)) continue;
+          if (hasCD) {
+            stretch.erase(stretch.begin() + static_cast<std::ptrdiff_t>(j));
+          } else {
+            stretch[j] = {std::min(c, d), std::max(c, d), toRestLength(restEdge(rest, c, d))};
+          }
+          break;
+        }
+        for (DistanceConstraint& l : shear) {
+          if (same(l, c, d)) l = {std::min(a, b), std::max(a, b), toRestLength(restEdge(rest, a, b))};
+        }
+        changed[a] = changed[b] = changed[c] = changed[d] = 1;
+        flipped = true;
+        break;  // t is another triangle now
+      }
+    }
+    if (!flipped) break;
+  }
+}
+
 // After openings: every particle whose fan fell apart splits, the constraints are made again, and
 // those of particles moved onto a line take their new rest lengths.
 void finishOpening(Cloth& cloth, Opening& opening, std::size_t particleBudget, std::vector<ParticleSplit>& splits) {
   ClothRest& rest = cloth.rest;
   Topology& topology = cloth.topology;
   const std::vector<ParticleIndex>& moved = opening.moved;
+  std::vector<ParticleIndex> around = opening.touched;
+  around.insert(around.end(), moved.begin(), moved.end());
   splitParticles(cloth, std::move(opening.touched), particleBudget, splits);
+  for (std::size_t p = opening.firstNew; p < rest.particleCount(); ++p) around.push_back(static_cast<ParticleIndex>(p));
   rebuildConstraints(cloth);
   // A particle moved onto the cut (and its copies) is at a new rest distance from its neighbours.
   std::vector<std::uint8_t> shifted(rest.particleCount(), 0);
@@ -773,6 +1035,7 @@ void finishOpening(Cloth& cloth, Opening& opening, std::size_t particleBudget, s
       }
     }
   }
+  flipAround(cloth, around);
   // Recipes afresh: those found again in split triangles may name other witnesses than a fresh
   // search (a snapshot loaded) finds. The rest frames are made again when next needed.
   makeTemplates(cloth);
@@ -817,6 +1080,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
   };
   const std::vector<std::uint8_t> onCut = line.onCut;
   Opening opening;
+  opening.firstNew = n0;
   openAlong(cloth, line, nullptr, particleBudget, inserted, opening);
   // A link no triangle witnesses (a chain) breaks where the cut crosses it.
   for (ConstraintTemplate& x : topology.templates) {
@@ -1170,6 +1434,7 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     // after the relaxation, so neighbouring breaks do not cut out slivers and islands between them.
     std::vector<std::uint8_t> near(n, 0);
     Opening opening;
+    opening.firstNew = cloth.rest.particleCount();
     std::vector<ParticleIndex> broken;
     const std::size_t insertedBefore = inserted.size();
     bool started = pass > 0;
