@@ -94,6 +94,22 @@ TEST(Cusick, ASilkDiscHangsLowerThanADenimOneAndBothComeToRest) {
   EXPECT_LT(silk.coefficient + 0.15, denim.coefficient);
 }
 
+TEST(Cusick, ADiscStillMovingWhenFirstLookedAtIsReadWhereItComesToRest) {
+  // Looked at after 0.5 s the silk disc is still falling; the lab waits for it to stop (no particle
+  // moving 0.01 mm in a frame) and reads the drape there: the drape a 5 s wait reads.
+  CusickSpec spec;
+  spec.spacing = 0.0125;
+  spec.fabric = sim::Fabric{0.045, 2.0e-6, 5.0e3, 30.0};
+  const CusickResult patient = cusick(spec);
+  spec.settle = 0.5;
+  const CusickResult early = cusick(spec);
+  ASSERT_FALSE(early.diverged);
+  EXPECT_GT(early.motion, 1e-4);
+  EXPECT_GT(early.restedAt, 0.5);
+  EXPECT_NEAR(early.coefficient, patient.coefficient, 0.01);
+  EXPECT_EQ(patient.restedAt, 5.0);
+}
+
 }  // namespace
 }  // namespace drape::analysis
 

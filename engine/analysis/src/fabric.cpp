@@ -318,12 +318,25 @@ CusickResult cusick(const CusickSpec& spec) {
     result.diverged = true;
     return result;
   }
-  const std::vector<sim::Vec3> before = world.cloths()[0].state.position;
-  result.diverged = world.step() != sim::StepStatus::ok;
-  const sim::Cloth& c = world.cloths()[0];
-  for (std::size_t i = 0; i < before.size(); ++i) {
-    result.motion = std::max(result.motion, glm::length(c.state.position[i] - before[i]));
+  // The frame that ends at settle, then frames until one moves nothing more than `rest`.
+  const double dt = world.settings().solver.dt;
+  const auto lastFrames = static_cast<std::int64_t>(std::ceil(spec.longest / dt));
+  for (std::int64_t frame = 0; frame <= lastFrames; ++frame) {
+    const std::vector<sim::Vec3> before = world.cloths()[0].state.position;
+    if (world.step() != sim::StepStatus::ok) {
+      result.diverged = true;
+      return result;
+    }
+    double motion = 0.0;
+    const std::vector<sim::Vec3>& after = world.cloths()[0].state.position;
+    for (std::size_t i = 0; i < before.size(); ++i) motion = std::max(motion, glm::length(after[i] - before[i]));
+    if (frame == 0) result.motion = motion;
+    if (motion <= spec.rest) {
+      result.restedAt = spec.settle + static_cast<double>(frame) * dt;
+      break;
+    }
   }
+  const sim::Cloth& c = world.cloths()[0];
   // The shadow on a grid of 0.5 mm cells: a cell is covered where its centre lies in a triangle
   // seen from above; its radius goes to the angle's bin (1 degree) of the edge profile.
   constexpr double kCell = 0.0005;

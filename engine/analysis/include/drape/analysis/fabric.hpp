@@ -71,15 +71,18 @@ struct CusickSpec {
   int substeps = 10;
   int iterations = 4;
   bool lines = false;
-  double settle = 5.0;   // s
+  double settle = 5.0;   // s: the time to be at rest by
   double damping = 4.0;  // 1/s
+  double rest = 1e-5;    // m: at rest when no particle moves more than this in a frame
+  double longest = 20.0;  // s: how long it may hang, past settle, to come to rest
 };
 
 struct CusickResult {
-  double coefficient = 0.0;  // DC, 0..1
+  double coefficient = 0.0;  // DC, 0..1, read where it came to rest (or at longest)
   int nodes = 0;
   double shadowArea = 0.0;  // m^2
-  double motion = 0.0;      // m, the most a particle moved in the last frame
+  double motion = 0.0;      // m, the most a particle moved in the frame that ends at settle
+  double restedAt = -1.0;   // s: the end of the first frame, from settle on, that moved none more than rest; -1 if none by longest
   int particles = 0;
   double seconds = 0.0;
   bool diverged = false;
@@ -87,7 +90,9 @@ struct CusickResult {
 
 // The disc drawn as an outline (sim::OutlineSpec, a polygon of 180 corners) at 0.5 m, its particles
 // within the support's radius pinned where they lie (the clamp), settled under gravity; the shadow
-// is the mesh's triangles projected onto the table, counted on a grid of 0.5 mm cells.
+// is the mesh's triangles projected onto the table, counted on a grid of 0.5 mm cells, once the
+// disc is at rest: a fine disc can still be folding over into another shape at `settle` (a slow
+// buckle), and the coefficient is read, as the standard reads it, from the drape it comes to.
 CusickResult cusick(const CusickSpec& spec);
 
 // Rotation kept: a square of fabric in free space (no gravity, drag or damping), spun about an
