@@ -433,6 +433,22 @@ TEST(Cutting, ACurvedSwipeCutsAlongItsPathAndEitherPieceLiftsAlone) {
   EXPECT_GT(lowest, 0.05);
 }
 
+// What a cut or tear must never leave: a particle in no triangle (an invisible point with its
+// mass), a link no triangle witnesses (it would hold across a later tear), a triangle turned over
+// at rest.
+void expectSoundMesh(const Cloth& cloth, const std::string& when) {
+  std::vector<std::uint8_t> used(cloth.state.position.size(), 0);
+  for (const glm::uvec3& t : cloth.rest.triangles) used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0) << "particles in no triangle " << when;
+  const auto free =
+      std::count_if(cloth.topology.templates.begin(), cloth.topology.templates.end(),
+                    [](const ConstraintTemplate& x) { return x.link == ConstraintTemplate::Link::free && !x.broken; });
+  EXPECT_EQ(free, 0) << "links no triangle witnesses " << when;
+  bool oneWay = false;
+  smallestAngle(cloth, oneWay);
+  EXPECT_TRUE(oneWay) << "a triangle turned over " << when;
+}
+
 // Numbers in [0, 1), the same on every machine (a linear congruential generator).
 struct Uniform {
   std::uint64_t state = 12345;
@@ -467,11 +483,13 @@ TEST(Cutting, ManyCrossingCutsAndTearsLeaveNoTriangleFoldedOrEmptyAndTheMassAsIt
     }
     world.releaseFinger(1);
     world.releaseFinger(2);
+    expectSoundMesh(cloth, "after tear " + std::to_string(round + 1));
     for (int i = 0; i < 100; ++i) {
       const Vec3 a{-0.2 + 1.4 * next(), 0.0, -0.2 + 1.4 * next()}, b{-0.2 + 1.4 * next(), 0.0, -0.2 + 1.4 * next()};
       for (int k = 0; k < 3; ++k)
         world.cut(a + (b - a) * (k / 3.0), a + (b - a) * ((k + 1) / 3.0), Vec3{0.0, -1.0, 0.0});
     }
+    expectSoundMesh(cloth, "after the swipes of round " + std::to_string(round + 1));
   }
   EXPECT_GT(tears, 0u);
   EXPECT_GT(cloth.pieceCount, 100u);
@@ -487,27 +505,46 @@ TEST(Cutting, ManyCrossingCutsAndTearsLeaveNoTriangleFoldedOrEmptyAndTheMassAsIt
   ASSERT_EQ(world.run(10), StepStatus::ok);
 }
 
-TEST(Cutting, ThirtyCrossingSwipesLeaveNoSliverAndNoShortEdge) {
-  // Thirty random swipes of 3 segments over a 24 x 24 sheet, crossing one another and their own
-  // earlier cuts at every angle: every triangle keeps its smallest angle over 10 degrees and its
-  // edges over a fifth of the spacing (the bound for one cut, held over many). Before two
-  // crossings of one triangle could share a particle and slivers flip, the 15th swipe left a
-  // 9.8-degree triangle and the 16th an edge of 0.15 spacing.
+TEST(Cutting, TwoHundredCrossingSwipesLeaveFewSliversOrShortEdgesInThePiecesThatAreLeft) {
+  // 200 random swipes of 3 segments over a 24 x 24 sheet, crossing one another and their own
+  // earlier cuts at every angle, cut it into some 1,200 pieces. Shreds of a few triangles between
+  // two close cuts are as thin as the cuts made them; in the pieces of more than 5 triangles,
+  // under 0.5 % of the triangles have an angle under 10 degrees and under 2 % an edge under a
+  // fifth of a spacing (0.1 and 0.7 %; before crossings shared particles and slivers flipped,
+  // 0.9 and 7.5 %). The mesh stays sound after every swipe and the mass is what it was.
   const int n = 24;
   const Real h = 1.0 / (n - 1);
   World world(flatSheet(n));
   const Real mass = totalMass(world);
   Uniform next;
   const Cloth& cloth = world.cloths()[0];
-  for (int i = 0; i < 30; ++i) {
+  for (int i = 0; i < 200; ++i) {
     const Vec3 a{-0.2 + 1.4 * next(), 0.0, -0.2 + 1.4 * next()}, b{-0.2 + 1.4 * next(), 0.0, -0.2 + 1.4 * next()};
     for (int k = 0; k < 3; ++k) world.cut(a + (b - a) * (k / 3.0), a + (b - a) * ((k + 1) / 3.0), Vec3{0.0, -1.0, 0.0});
-    bool oneWay = false;
-    ASSERT_GE(smallestAngle(cloth, oneWay), 10.0) << "after swipe " << i + 1;
-    ASSERT_TRUE(oneWay) << "after swipe " << i + 1;
-    ASSERT_GE(shortestEdge(cloth), 0.2 * h) << "after swipe " << i + 1;
+    expectSoundMesh(cloth, "after swipe " + std::to_string(i + 1));
+    if (HasFailure()) return;
   }
-  EXPECT_GT(cloth.pieceCount, 20u);
+  std::vector<std::size_t> size(cloth.pieceCount, 0);
+  for (const glm::uvec3& t : cloth.rest.triangles) ++size[cloth.pieceOf(t[0])];
+  std::size_t counted = 0, sharp = 0, short_ = 0;
+  for (const glm::uvec3& t : cloth.rest.triangles) {
+    if (size[cloth.pieceOf(t[0])] <= 5) continue;
+    ++counted;
+    const Vec3 p[3] = {cloth.rest.restPosition(t[0]), cloth.rest.restPosition(t[1]), cloth.rest.restPosition(t[2])};
+    Real angle = 180.0, edge = 1e300;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+      edge = std::min(edge, glm::length(u));
+      angle = std::min(angle, std::acos(std::clamp(glm::dot(glm::normalize(u), glm::normalize(v)), -1.0, 1.0)) * 180.0 /
+                                  3.141592653589793);
+    }
+    sharp += angle < 10.0;
+    short_ += edge < 0.2 * h;
+  }
+  EXPECT_GT(cloth.pieceCount, 1000u);
+  ASSERT_GT(counted, 500u);
+  EXPECT_LT(static_cast<Real>(sharp), 0.005 * static_cast<Real>(counted));
+  EXPECT_LT(static_cast<Real>(short_), 0.02 * static_cast<Real>(counted));
   EXPECT_NEAR(totalMass(world), mass, 1e-12 * mass);
 }
 

@@ -377,6 +377,8 @@ constexpr Real kMergeChord = 0.2;
 // Tries at sharing before every crossing keeps its own particle.
 constexpr int kMergeAttempts = 4;
 // A child a shared particle makes needs at least this many spacings squared of doubled area.
+constexpr Real kLeastMergedArea = 2e-2;
+// A triangle a particle moved onto the line leaves needs at least this many.
 constexpr Real kLeastChildArea = 1e-3;
 
 Real restEdge(const ClothRest& rest, ParticleIndex a, ParticleIndex b) {
@@ -525,8 +527,32 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
       }
     }
     if (!(best <= 0.4 * shortest)) continue;
-    rest.restOffsets[p] += static_cast<float>(bestS) * (rest.restOffsets[to] - rest.restOffsets[p]);
-    s.position[p] = glm::mix(s.position[p], s.position[to], bestS);
+    // Several breaks of one tear can each move a particle by that much, together turning a
+    // triangle over: none of its triangles may come to face the other way, or lie flat, at rest
+    // or now.
+    const glm::vec3 offset =
+        rest.restOffsets[p] + static_cast<float>(bestS) * (rest.restOffsets[to] - rest.restOffsets[p]);
+    const Vec3 now = glm::mix(s.position[p], s.position[to], bestS);
+    bool fair = true;
+    for (auto t = incidence.begin(static_cast<ParticleIndex>(p));
+         t != incidence.end(static_cast<ParticleIndex>(p)) && fair; ++t) {
+      const Triangle& c = rest.triangles[*t];
+      Vec3 r[3], y[3];
+      for (int k = 0; k < 3; ++k) {
+        r[k] = c[k] == p ? rest.restOrigin + Vec3(offset) : rest.restPosition(c[k]);
+        y[k] = c[k] == p ? now : s.position[c[k]];
+      }
+      const Vec3 restFacing = glm::cross(rest.restPosition(c[1]) - rest.restPosition(c[0]),
+                                         rest.restPosition(c[2]) - rest.restPosition(c[0]));
+      const Vec3 nowFacing = glm::cross(s.position[c[1]] - s.position[c[0]], s.position[c[2]] - s.position[c[0]]);
+      const Real least = kLeastChildArea * topology.spacing * topology.spacing * glm::length(restFacing);
+      if (!(glm::dot(glm::cross(r[1] - r[0], r[2] - r[0]), restFacing) > least) ||
+          !(glm::dot(glm::cross(y[1] - y[0], y[2] - y[0]), nowFacing) > 0.0))
+        fair = false;
+    }
+    if (!fair) continue;
+    rest.restOffsets[p] = offset;
+    s.position[p] = now;
     s.previousPosition[p] = glm::mix(s.previousPosition[p], s.previousPosition[to], bestS);
     if (!s.velocity.empty()) s.velocity[p] = glm::mix(s.velocity[p], s.velocity[to], bestS);
     distance[p] = 0.0;
@@ -541,9 +567,10 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
   // triangle closer than kMergeChord spacings at rest share one particle, halfway between them (on
   // the plane still, and off each edge by at most half that). The triangle then loses the corner's
   // child, which its neighbours across the two edges cover, and the cut passes through the shared
-  // particle. Where that would turn a triangle over (a neighbour with an angle under about 25
-  // degrees beside the crossing), the two stay apart: a guard, which some 28,000 random swipes over
-  // lattices and drawn cloths never needed.
+  // particle. Not where the corner has no neighbour across either edge (it would be left in no
+  // triangle); and where a child would turn over or keep almost no area, at rest or now (a
+  // neighbour with an angle under about 25 degrees beside the crossing), the two stay apart and
+  // all is made again: a guard, which some 8,000 random swipes over lattices never needed.
   const auto crossingIndex = [&](ParticleIndex p, ParticleIndex q) -> std::int64_t {
     const auto found = std::lower_bound(crossing.begin(), crossing.end(), std::pair{key(p, q), ParticleIndex{0}});
     return found != crossing.end() && found->first == key(p, q) ? found - crossing.begin() : -1;
@@ -575,6 +602,11 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
         for (int k = 0; k < 3; ++k) {
           const std::int64_t a = crossingIndex(c[k], c[(k + 1) % 3]), b = crossingIndex(c[(k + 1) % 3], c[(k + 2) % 3]);
           if (a < 0 || b < 0) continue;
+          // The corner between them keeps triangles only through the neighbours across the two
+          // edges: with neither (a corner of the border) it would be left in none.
+          if (topology.neighbour[t][static_cast<std::size_t>(k)] < 0 &&
+              topology.neighbour[t][static_cast<std::size_t>((k + 1) % 3)] < 0)
+            continue;
           const auto ua = static_cast<std::size_t>(a), ub = static_cast<std::size_t>(b);
           if (partner[ua] >= 0 || partner[ub] >= 0 || apart[ua] || apart[ub]) continue;
           if (!(glm::length(crossingRest(ua) - crossingRest(ub)) < mergeChord)) continue;
@@ -714,7 +746,12 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
         if (!shared) continue;
         const Vec3 n = glm::cross(rest.restPosition(child.corners[1]) - rest.restPosition(child.corners[0]),
                                   rest.restPosition(child.corners[2]) - rest.restPosition(child.corners[0]));
-        if (glm::dot(n, facing) > kLeastChildArea * size * topology.spacing * topology.spacing) continue;
+        const Vec3 nowFacing = glm::cross(s.position[c[1]] - s.position[c[0]], s.position[c[2]] - s.position[c[0]]);
+        const Vec3 nowChild = glm::cross(s.position[child.corners[1]] - s.position[child.corners[0]],
+                                         s.position[child.corners[2]] - s.position[child.corners[0]]);
+        if (glm::dot(n, facing) > kLeastMergedArea * size * topology.spacing * topology.spacing &&
+            glm::dot(nowChild, nowFacing) > 0.0)
+          continue;
         for (int k = 0; k < 3; ++k) {
           const ParticleIndex p = child.corners[k];
           if (p < n0) continue;
@@ -894,7 +931,9 @@ constexpr Real kFlipFlat = 0.996;  // about 5 degrees
 // still joined flip, so the border stays where the cuts put it; only quads convex at rest and
 // flat now (the surface does not change shape), so no triangle turns over. The stretch link along
 // the edge moves to the new one; a shear link on the new one (a lattice's other diagonal) moves to
-// the old.
+// the old. A flip that would leave another link of its corners without a triangle to witness it
+// (a neighbouring quad's diagonal, a bend through a corner: addTemplates) is undone, so every
+// link still breaks where the cloth is cut or torn.
 void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
   ClothRest& rest = cloth.rest;
   Topology& topology = cloth.topology;
@@ -904,6 +943,38 @@ void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
   for (const ParticleIndex p : around) {
     if (p < n) near[p] = 1;
   }
+  // Each particle's triangles, kept up as triangles flip; each particle's links (kind, index).
+  std::vector<std::vector<std::uint32_t>> fan(n);
+  for (std::uint32_t t = 0; t < rest.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) fan[rest.triangles[t][k]].push_back(t);
+  }
+  std::vector<std::vector<std::pair<std::uint8_t, std::uint32_t>>> links(n);
+  for (std::size_t k = 0; k < kConstraintKindCount; ++k) {
+    for (std::uint32_t j = 0; j < rest.constraints[k].size(); ++j) {
+      const DistanceConstraint& c = rest.constraints[k][j];
+      links[c.a].push_back({static_cast<std::uint8_t>(k), j});
+      links[c.b].push_back({static_cast<std::uint8_t>(k), j});
+    }
+  }
+  const auto has = [&](std::uint32_t t, ParticleIndex q) { return cornerOf(rest.triangles[t], q) >= 0; };
+  // As addTemplates finds a witness: p and q in one triangle, in two joined across an edge, or
+  // each in a triangle with a middle particle.
+  const auto witnessed = [&](ParticleIndex p, ParticleIndex q) {
+    for (const std::uint32_t t : fan[p]) {
+      if (has(t, q)) return true;
+      for (const std::int32_t o : topology.neighbour[t]) {
+        if (o >= 0 && has(static_cast<std::uint32_t>(o), q)) return true;
+      }
+      for (int m = 0; m < 3; ++m) {
+        const ParticleIndex middle = rest.triangles[t][m];
+        if (middle == p) continue;
+        for (const std::uint32_t u : fan[middle]) {
+          if (has(u, q)) return true;
+        }
+      }
+    }
+    return false;
+  };
   const auto normal = [&](auto&& at, ParticleIndex a, ParticleIndex b, ParticleIndex c) {
     return glm::cross(at(b) - at(a), at(c) - at(a));
   };
@@ -913,22 +984,52 @@ void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
     const Real l = glm::length(v);
     return l > 0.0 ? v / l : Vec3{0.0};
   };
+  const auto erase = [](std::vector<std::uint32_t>& list, std::uint32_t t) {
+    list.erase(std::find(list.begin(), list.end(), t));
+  };
+  // Replaces triangle t by `corners` and o by `cornersO`, their neighbours and the fans following.
+  const auto setPair = [&](std::uint32_t t, Triangle corners, std::array<std::int32_t, 3> nt, std::uint32_t o,
+                           Triangle cornersO, std::array<std::int32_t, 3> no) {
+    for (const std::uint32_t u : {t, o}) {
+      for (int k = 0; k < 3; ++k) erase(fan[rest.triangles[u][k]], u);
+    }
+    rest.triangles[t] = corners;
+    rest.triangles[o] = cornersO;
+    topology.neighbour[t] = nt;
+    topology.neighbour[o] = no;
+    // The triangles across from the pair point back, edge by edge, at whichever of the two has it now.
+    for (const std::uint32_t u : {t, o}) {
+      const Triangle& cu = rest.triangles[u];
+      for (int k = 0; k < 3; ++k) {
+        fan[cu[k]].push_back(u);
+        const std::int32_t w = topology.neighbour[u][static_cast<std::size_t>(k)];
+        if (w < 0 || static_cast<std::uint32_t>(w) == t || static_cast<std::uint32_t>(w) == o) continue;
+        const Triangle& cw = rest.triangles[static_cast<std::size_t>(w)];
+        for (int e = 0; e < 3; ++e) {
+          if (std::minmax(cw[e], cw[(e + 1) % 3]) == std::minmax(cu[k], cu[(k + 1) % 3]))
+            topology.neighbour[static_cast<std::size_t>(w)][static_cast<std::size_t>(e)] = static_cast<std::int32_t>(u);
+        }
+      }
+    }
+    topology.triangleArea[t] = triangleArea(rest, rest.triangles[t]);
+    topology.triangleArea[o] = triangleArea(rest, rest.triangles[o]);
+  };
+  const auto same = [](const DistanceConstraint& l, ParticleIndex p, ParticleIndex q) {
+    return (l.a == p && l.b == q) || (l.a == q && l.b == p);
+  };
   for (int pass = 0; pass < kFlipPasses; ++pass) {
-    const Incidence incidence(rest.triangles, n);
     std::vector<std::uint32_t> candidates;
     for (std::size_t p = 0; p < n; ++p) {
       if (!near[p]) continue;
-      for (auto t = incidence.begin(static_cast<ParticleIndex>(p)); t != incidence.end(static_cast<ParticleIndex>(p));
-           ++t) {
-        candidates.push_back(*t);
-        for (const std::int32_t o : topology.neighbour[*t]) {
+      for (const std::uint32_t t : fan[p]) {
+        candidates.push_back(t);
+        for (const std::int32_t o : topology.neighbour[t]) {
           if (o >= 0) candidates.push_back(static_cast<std::uint32_t>(o));
         }
       }
     }
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-    std::vector<std::uint8_t> changed(n, 0);  // corners of a flip this pass (their incidence is stale)
     bool flipped = false;
     for (const std::uint32_t t : candidates) {
       for (int k = 0; k < 3; ++k) {
@@ -941,7 +1042,7 @@ void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
         while (ko < 3 && !(to[ko] == b && to[(ko + 1) % 3] == a)) ++ko;
         if (ko == 3) continue;  // joined the other way round: leave it
         const ParticleIndex d = to[(ko + 2) % 3];
-        if (c == d || changed[a] || changed[b] || changed[c] || changed[d]) continue;
+        if (c == d) continue;
         const Real before = std::min(smallestAngle(rest, a, b, c), smallestAngle(rest, b, a, d));
         if (!(before < kFlipBelow)) continue;
         const Real after = std::min(smallestAngle(rest, a, d, c), smallestAngle(rest, d, b, c));
@@ -956,50 +1057,75 @@ void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
             !(glm::dot(unit(normal(nowAt, d, b, c)), nt + no) > 0.0))
           continue;
         // Not an edge already (a triangle elsewhere with both c and d).
-        bool taken = false;
-        for (auto u = incidence.begin(c); u != incidence.end(c) && !taken; ++u)
-          taken = cornerOf(rest.triangles[*u], d) >= 0;
-        if (taken) continue;
+        if (std::any_of(fan[c].begin(), fan[c].end(), [&](std::uint32_t u) { return has(u, d); })) continue;
+        // The links of the four corners a triangle witnesses now (but a-b, which moves).
+        std::vector<std::pair<std::uint8_t, std::uint32_t>> kept;
+        for (const ParticleIndex p : {a, b, c, d}) {
+          for (const auto& link : links[p]) {
+            const DistanceConstraint& l = rest.constraints[link.first][link.second];
+            if (same(l, a, b) || same(l, c, d)) continue;
+            if (witnessed(l.a, l.b)) kept.push_back(link);
+          }
+        }
         // t becomes (a, d, c) and o (d, b, c).
         const std::array<std::int32_t, 3> oldT = topology.neighbour[t], oldO = topology.neighbour[o];
-        rest.triangles[t] = Triangle(a, d, c);
-        rest.triangles[o] = Triangle(d, b, c);
-        const std::int32_t acrossAD = oldO[static_cast<std::size_t>((ko + 1) % 3)];
-        const std::int32_t acrossBC = oldT[static_cast<std::size_t>((k + 1) % 3)];
-        topology.neighbour[t] = {acrossAD, static_cast<std::int32_t>(o), oldT[static_cast<std::size_t>((k + 2) % 3)]};
-        topology.neighbour[o] = {oldO[static_cast<std::size_t>((ko + 2) % 3)], acrossBC, static_cast<std::int32_t>(t)};
-        if (acrossAD >= 0) {
-          for (std::int32_t& back : topology.neighbour[static_cast<std::size_t>(acrossAD)]) {
-            if (back == static_cast<std::int32_t>(o)) back = static_cast<std::int32_t>(t);
-          }
+        setPair(t, Triangle(a, d, c),
+                {oldO[static_cast<std::size_t>((ko + 1) % 3)], static_cast<std::int32_t>(o),
+                 oldT[static_cast<std::size_t>((k + 2) % 3)]},
+                o, Triangle(d, b, c),
+                {oldO[static_cast<std::size_t>((ko + 2) % 3)], oldT[static_cast<std::size_t>((k + 1) % 3)],
+                 static_cast<std::int32_t>(t)});
+        const bool lost = std::any_of(kept.begin(), kept.end(), [&](const auto& link) {
+          const DistanceConstraint& l = rest.constraints[link.first][link.second];
+          return !witnessed(l.a, l.b);
+        });
+        if (lost) {
+          setPair(t, tt, oldT, o, to, oldO);
+          continue;
         }
-        if (acrossBC >= 0) {
-          for (std::int32_t& back : topology.neighbour[static_cast<std::size_t>(acrossBC)]) {
-            if (back == static_cast<std::int32_t>(t)) back = static_cast<std::int32_t>(o);
-          }
-        }
-        topology.triangleArea[t] = triangleArea(rest, rest.triangles[t]);
-        topology.triangleArea[o] = triangleArea(rest, rest.triangles[o]);
-        // The links: stretch from a-b to c-d, a shear on c-d to a-b.
-        const auto same = [](const DistanceConstraint& l, ParticleIndex p, ParticleIndex q) {
-          return (l.a == p && l.b == q) || (l.a == q && l.b == p);
-        };
+        // The links: stretch from a-b to c-d (or gone where c-d has one), a shear on c-d to a-b.
         auto& stretch = rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
         auto& shear = rest.constraints[static_cast<std::size_t>(ConstraintKind::shear)];
-        const bool hasCD = std::any_of(stretch.begin(), stretch.end(), [&](const auto& l) { return same(l, c, d); });
-        for (std::size_t j = 0; j < stretch.size(); ++j) {
-          if (!same(stretch[j], a, b)) continue;
-          if (hasCD) {
-            stretch.erase(stretch.begin() + static_cast<std::ptrdiff_t>(j));
-          } else {
-            stretch[j] = {std::min(c, d), std::max(c, d), toRestLength(restEdge(rest, c, d))};
+        const auto linkOf = [&](ConstraintKind kind, ParticleIndex p, ParticleIndex q) -> std::int64_t {
+          for (const auto& link : links[p]) {
+            if (link.first == static_cast<std::uint8_t>(kind) && same(rest.constraints[link.first][link.second], p, q))
+              return link.second;
           }
-          break;
+          return -1;
+        };
+        const auto relink = [&](ConstraintKind kind, std::uint32_t j, ParticleIndex from1, ParticleIndex from2,
+                                ParticleIndex to1, ParticleIndex to2) {
+          const auto k8 = static_cast<std::uint8_t>(kind);
+          for (const ParticleIndex q : {from1, from2}) {
+            auto& list = links[q];
+            list.erase(std::find(list.begin(), list.end(), std::pair{k8, j}));
+          }
+          rest.constraints[static_cast<std::size_t>(kind)][j] = {std::min(to1, to2), std::max(to1, to2),
+                                                                 toRestLength(restEdge(rest, to1, to2))};
+          links[to1].push_back({k8, j});
+          links[to2].push_back({k8, j});
+        };
+        const std::int64_t ab = linkOf(ConstraintKind::stretch, a, b);
+        const std::int64_t cdShear = linkOf(ConstraintKind::shear, c, d);
+        const bool cdStretch = linkOf(ConstraintKind::stretch, c, d) >= 0;
+        if (cdShear >= 0) relink(ConstraintKind::shear, static_cast<std::uint32_t>(cdShear), c, d, a, b);
+        if (ab >= 0 && !cdStretch) relink(ConstraintKind::stretch, static_cast<std::uint32_t>(ab), a, b, c, d);
+        if (ab >= 0 && cdStretch) {
+          // (Rare: c-d had a stretch link of its own.) The a-b one goes; the indices after it move down.
+          stretch.erase(stretch.begin() + ab);
+          for (auto& list : links) {
+            list.erase(std::remove(list.begin(), list.end(),
+                                   std::pair{static_cast<std::uint8_t>(ConstraintKind::stretch),
+                                             static_cast<std::uint32_t>(ab)}),
+                       list.end());
+            for (auto& link : list) {
+              if (link.first == static_cast<std::uint8_t>(ConstraintKind::stretch) &&
+                  link.second > static_cast<std::uint32_t>(ab))
+                --link.second;
+            }
+          }
         }
-        for (DistanceConstraint& l : shear) {
-          if (same(l, c, d)) l = {std::min(a, b), std::max(a, b), toRestLength(restEdge(rest, a, b))};
-        }
-        changed[a] = changed[b] = changed[c] = changed[d] = 1;
+        (void)shear;
         flipped = true;
         break;  // t is another triangle now
       }
