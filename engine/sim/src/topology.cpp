@@ -646,7 +646,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
           0.5 * (s.previousPosition[particle] + glm::mix(s.previousPosition[p2], s.previousPosition[q2], at2));
       if (!s.velocity.empty())
         s.velocity[particle] = 0.5 * (s.velocity[particle] + glm::mix(s.velocity[p2], s.velocity[q2], at2));
-      if (s.pinned[particle] != (s.pinned[p2] && s.pinned[q2] ? 1 : 0)) {
+      if (!(s.pinned[p2] && s.pinned[q2])) {  // pinned only where all four ends are
         s.pinned[particle] = 0;
         s.inverseMass[particle] = 1.0;
       }
@@ -1085,7 +1085,6 @@ void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
         }
         // The links: stretch from a-b to c-d (or gone where c-d has one), a shear on c-d to a-b.
         auto& stretch = rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
-        auto& shear = rest.constraints[static_cast<std::size_t>(ConstraintKind::shear)];
         const auto linkOf = [&](ConstraintKind kind, ParticleIndex p, ParticleIndex q) -> std::int64_t {
           for (const auto& link : links[p]) {
             if (link.first == static_cast<std::uint8_t>(kind) && same(rest.constraints[link.first][link.second], p, q))
@@ -1125,7 +1124,6 @@ void flipAround(Cloth& cloth, const std::vector<ParticleIndex>& around) {
             }
           }
         }
-        (void)shear;
         flipped = true;
         break;  // t is another triangle now
       }

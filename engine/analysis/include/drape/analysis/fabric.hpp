@@ -71,9 +71,9 @@ struct CusickSpec {
   int substeps = 10;
   int iterations = 4;
   bool lines = false;
-  double settle = 5.0;   // s: the time to be at rest by
-  double damping = 4.0;  // 1/s
-  double rest = 1e-5;    // m: at rest when no particle moves more than this in a frame
+  double settle = 5.0;    // s: the time to be at rest by
+  double damping = 4.0;   // 1/s
+  double rest = 1e-5;     // m: at rest when no particle moves more than this in a frame
   double longest = 20.0;  // s: how long it may hang, past settle, to come to rest
 };
 
@@ -82,7 +82,9 @@ struct CusickResult {
   int nodes = 0;
   double shadowArea = 0.0;  // m^2
   double motion = 0.0;      // m, the most a particle moved in the frame that ends at settle
-  double restedAt = -1.0;   // s: the end of the first frame, from settle on, that moved none more than rest; -1 if none by longest
+  // s: the end of the first frame, from settle on, that moved no particle more than rest; -1 if none by
+  // settle + longest
+  double restedAt = -1.0;
   int particles = 0;
   double seconds = 0.0;
   bool diverged = false;
