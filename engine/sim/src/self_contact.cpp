@@ -32,7 +32,8 @@ constexpr Real kCoincident = 1e-12;
 // pushes nothing: a free corner of weight 0.004 in a triangle whose other corners and the vertex
 // fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair apart instead.
 constexpr Real kLeverage = 0.25;
-// How many times its rest size a triangle or edge may be stretched and still take part.
+// How many times its rest size a triangle or edge may be stretched and still take part (longer
+// than its cloth at rest too, it takes none: findPairs).
 constexpr Real kTorn = 10.0;
 
 // Triangles a leaf of the broad phase's tree holds at most.
@@ -144,11 +145,12 @@ bool overlap(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& otherLo,
 
 std::size_t SelfContact::bytes() const {
   const auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  std::size_t total = b(clothOf_) + b(rest_) + b(triangles_) + b(edges_) + b(edgeTriangles_) + b(vertexStart_) +
-                      b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) + b(upper_) + b(boxLower_) +
-                      b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) + b(triangleMoved_) +
-                      b(zone_) + b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) +
-                      b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_);
+  std::size_t total = b(clothOf_) + b(rest_) + b(clothSize_) + b(triangles_) + b(edges_) + b(edgeTriangles_) +
+                      b(vertexStart_) + b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) +
+                      b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
+                      b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) +
+                      b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) +
+                      b(made0_) + b(madeX_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
   for (const std::vector<Pair>& found : found_) total += b(found);
@@ -170,6 +172,19 @@ void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
     for (const glm::uvec3& t : cloth.rest.triangles) triangles_.push_back(t + base);
   }
   const std::size_t n = clothOf_.size();
+  // Each cloth's size at rest: the diagonal of its rest shape's box, squared.
+  clothSize_.assign(cloths.size(), 0.0);
+  {
+    std::vector<Vec3> lo(cloths.size(), Vec3(std::numeric_limits<Real>::max()));
+    std::vector<Vec3> hi(cloths.size(), Vec3(std::numeric_limits<Real>::lowest()));
+    for (std::size_t i = 0; i < n; ++i) {
+      lo[clothOf_[i]] = glm::min(lo[clothOf_[i]], rest_[i]);
+      hi[clothOf_[i]] = glm::max(hi[clothOf_[i]], rest_[i]);
+    }
+    for (std::size_t c = 0; c < cloths.size(); ++c) {
+      if (lo[c].x <= hi[c].x) clothSize_[c] = glm::dot(hi[c] - lo[c], hi[c] - lo[c]);
+    }
+  }
   // Edges: each once, with the (one or two) triangles on it.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> sides;
   sides.reserve(triangles_.size() * 3);
@@ -358,8 +373,12 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
     upper_[i] = glm::max(glm::max(x0_[i], x_[i]), to) + grow;
   }
-  // A triangle or edge stretched past kTorn times its rest size is no cloth any more (a finger flung
-  // its patch 100 m): it takes no part, or its box would pair it with everything in between.
+  // A triangle or edge stretched past kTorn times its rest size and longer than its whole cloth at
+  // rest is no cloth any more (a finger flung its patch 100 m): it takes no part, or its box would
+  // pair it with everything in between. (Not by its rest size alone: on a fine lattice, where a twist
+  // winds the cloth round a grip, self-contact holds some of the grip's particles back while the
+  // rest move on, the links between them stretch ten times over within a few centimetres, and
+  // those triangles passed through the layers.)
   const auto longest = [&](const std::vector<Vec3>& x, const std::uint32_t* v, int count) {
     Real most = 0.0;
     for (int i = 0; i < count; ++i) {
@@ -369,7 +388,8 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     return most;
   };
   const auto torn = [&](const std::uint32_t* v, int count) {
-    return longest(x_, v, count) > kTorn * kTorn * longest(rest_, v, count) + 4.0 * grow * grow;
+    return longest(x_, v, count) >
+           std::max(kTorn * kTorn * longest(rest_, v, count), clothSize_[clothOf_[v[0]]]) + 4.0 * grow * grow;
   };
   const Vec3 none(std::numeric_limits<Real>::max());
   for (std::size_t t = 0; t < nt; ++t) {

@@ -123,6 +123,7 @@ class SelfContact {
   // The world's mesh, particles numbered across cloths.
   std::vector<std::uint32_t> clothOf_;                        // per particle
   std::vector<Vec3> rest_;                                    // rest positions
+  std::vector<Real> clothSize_;                               // per cloth: its rest box's diagonal, squared
   std::vector<glm::uvec3> triangles_;                         // world-wide corners
   std::vector<glm::uvec2> edges_;                             // unique, lower particle first
   std::vector<std::uint32_t> edgeTriangles_;                  // two per edge (kNone where only one)
