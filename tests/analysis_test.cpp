@@ -242,11 +242,12 @@ TEST(Cantilever, ADenimStripDroopsAsTheHeavyElasticaDoesWithinFivePercent) {
   }
 }
 
-TEST(Cantilever, ADrawnStripAlongTheLatticeComesCloserToTheElasticaAsItsMeshIsRefined) {
-  // Denim drawn as an outline, its sides cutting the cells (analysis::CantileverSpec::drawn), at
-  // 10 x 16 with lines: the clipped border's stencils and the jagged clamp cost bending at coarse
-  // spacings, and less as the mesh is refined. (Drawn at an angle to the lattice it does not come
-  // closer: docs/fabric.md, "Drawn strips".)
+TEST(Cantilever, ADrawnStripAlongTheLatticeIsWithinTwoPerCentOfTheElasticaAtEverySpacing) {
+  // Denim drawn as an outline (analysis::CantileverSpec::drawn), along the fill's lattice, its tip
+  // cutting the cells, at 10 x 16 with lines: read as the lattice strip is (from half a spacing
+  // behind the pinned particles' front), it is the lattice strip, and as close to the elastica.
+  // Read from the front itself it sat 17, 8 and 6 % soft. (Drawn at an angle to the lattice it is
+  // not yet: docs/fabric.md, "Drawn strips".)
   CantileverSpec spec;
   spec.fabric = sim::Fabric{0.324, 6.4e-5, 5.0e4, 150.0};
   spec.overhang = 2.0 * bendingLength(spec.fabric);
@@ -254,17 +255,14 @@ TEST(Cantilever, ADrawnStripAlongTheLatticeComesCloserToTheElasticaAsItsMeshIsRe
   spec.iterations = 16;
   spec.lines = true;
   spec.drawn = true;
-  double error = 1.0;
   for (double spacing : {0.0125, 0.00625, 0.003125}) {
     spec.spacing = spacing;
     const CantileverResult r = cantilever(spec);
     ASSERT_FALSE(r.diverged);
     EXPECT_LT(r.tipMotion, 1e-5) << "still moving";
-    const double now = std::abs(r.bendingLength / r.expected - 1.0);
-    EXPECT_LT(now, 0.75 * error) << spacing;
-    error = now;
+    EXPECT_NEAR(r.bendingLength / r.expected, 1.0, 0.02) << spacing;
+    EXPECT_GT(r.chordAngle, 35.0 * kDegree);  // a real droop, not a stiff strip
   }
-  EXPECT_LT(error, 0.07);
 }
 
 }  // namespace

@@ -342,8 +342,10 @@ int fabric(const FabricArguments& arguments) {
            << "rectangle at an angle to the fill's lattice, so its sides cut through the cells and its bend\n"
            << "stencils are those a drawn cloth gets (clipped cells along the border, lines at that angle to\n"
            << "the strip). Three spacings of it lie on the platform, every particle not beyond the edge pinned;\n"
-           << "the chord runs from the edge's middle to the middle of the tip's two corners. Denim, 10 x 16\n"
-           << "with lines. Target (issue 24): within 5 %, as the lattice strips.\n\n"
+           << "as on the lattice strip, the overhang and the chord (to the middle of the tip's two corners)\n"
+           << "are read from half a spacing behind that front, which its particles' bend stencils bend\n"
+           << "within half a spacing of. Denim, 10 x 16 with lines. Target (issue 24): within 5 %, as the\n"
+           << "lattice strips.\n\n"
            << "| spacing (mm) | angle to the lattice (deg) | chord (deg) | elastica (deg) | c (mm) | expected c (mm) | "
               "error | tip motion (mm) | worst strain | run (s) |\n"
            << "|---|---|---|---|---|---|---|---|---|---|\n";

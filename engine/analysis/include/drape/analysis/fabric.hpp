@@ -55,7 +55,8 @@ struct CantileverResult {
 // The strip, lying along +x with its first two columns pinned (the platform, whose edge is halfway
 // between them), left to settle under gravity. The overhang is from that edge to the tip. Drawn:
 // three spacings of the strip lie on the platform, every particle not beyond its edge pinned, and
-// the chord runs from the edge's middle to the middle of the tip's two corners.
+// the overhang and the chord (to the middle of the tip's two corners) are read from half a spacing
+// behind the edge, as the lattice strip's are from half a spacing behind its last pinned column.
 CantileverResult cantilever(const CantileverSpec& spec);
 
 // The Cusick drape test (BS 5058, ISO 9073-9): a disc of fabric clamped between two smaller discs
