@@ -198,9 +198,10 @@ CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::
   world.restoreCloths(std::move(cloths));
 
   CantileverResult result;
-  // Read from half a spacing behind the pinned particles' front, as the lattice strip is (below):
-  // the bend stencils of the front's particles bend the strip within half a spacing of them on
-  // either side. (Read from the front itself, the strip along the lattice sat 17, 8 and 6 % soft at
+  // Read from half a spacing behind the platform's edge (along the lattice, where the front of the
+  // pinned particles lies), as the lattice strip is read from half a spacing behind its last pinned
+  // column (below): the bend stencils of the front's particles bend the strip within half a spacing
+  // of them on either side. (Read from the front itself, the strip along the lattice sat 17, 8 and 6 % soft at
   // 12.5, 6.25 and 3.125 mm, converging only linearly; so read, within 1.2 %.)
   const double behind = 0.5 * spec.spacing;
   result.overhang = spec.overhang + behind;

@@ -161,30 +161,23 @@ std::size_t SelfContact::bytes() const {
 void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
   clothOf_.clear();
   rest_.clear();
+  clothSize_.clear();
   triangles_.clear();
   for (std::size_t c = 0; c < cloths.size(); ++c) {
     const auto base = static_cast<std::uint32_t>(clothOf_.size());
     const Cloth& cloth = cloths[c];
+    // The cloth's size at rest: the diagonal of its rest shape's box, squared (0 with no particle).
+    Vec3 lo(std::numeric_limits<Real>::max()), hi(std::numeric_limits<Real>::lowest());
     for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
       clothOf_.push_back(static_cast<std::uint32_t>(c));
       rest_.push_back(cloth.rest.restPosition(i));
+      lo = glm::min(lo, rest_.back());
+      hi = glm::max(hi, rest_.back());
     }
+    clothSize_.push_back(lo.x <= hi.x ? glm::dot(hi - lo, hi - lo) : 0.0);
     for (const glm::uvec3& t : cloth.rest.triangles) triangles_.push_back(t + base);
   }
   const std::size_t n = clothOf_.size();
-  // Each cloth's size at rest: the diagonal of its rest shape's box, squared.
-  clothSize_.assign(cloths.size(), 0.0);
-  {
-    std::vector<Vec3> lo(cloths.size(), Vec3(std::numeric_limits<Real>::max()));
-    std::vector<Vec3> hi(cloths.size(), Vec3(std::numeric_limits<Real>::lowest()));
-    for (std::size_t i = 0; i < n; ++i) {
-      lo[clothOf_[i]] = glm::min(lo[clothOf_[i]], rest_[i]);
-      hi[clothOf_[i]] = glm::max(hi[clothOf_[i]], rest_[i]);
-    }
-    for (std::size_t c = 0; c < cloths.size(); ++c) {
-      if (lo[c].x <= hi[c].x) clothSize_[c] = glm::dot(hi[c] - lo[c], hi[c] - lo[c]);
-    }
-  }
   // Edges: each once, with the (one or two) triangles on it.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> sides;
   sides.reserve(triangles_.size() * 3);
