@@ -403,6 +403,49 @@ TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
   EXPECT_GT(within, 100);  // the tangle is a real test
 }
 
+// Where the contacts or a zone take particles out of their boxes, the fail-safe must know every pair
+// their new motion may bring together. Where few particles left (fewer than one in eight), their
+// triangles' and edges' pairs are found again (a refresh), else all by a search; either way the
+// pairs are those a search for the motion as it now is lists. Two sheets 3 cm apart, at rest: the
+// solve lists no pair between them; then particles of the upper sheet drop to 7 mm above the lower
+// (within two distances: their boxes overlap its triangles').
+TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
+  WorldSettings settings = withSelfContact({});
+  settings.cloths.push_back(flatSheet(9, 0.2, {-0.1, 0.0, -0.1}));
+  settings.cloths.push_back(flatSheet(7, 0.15, {-0.07, 0.03, -0.07}));
+  const std::vector<Cloth> cloths = World(settings).cloths();
+  using Listed = std::set<std::tuple<bool, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>>;
+  const auto listed = [](const contact::SelfContact& contact) {
+    Listed pairs;
+    for (const contact::SelfContact::Pair& p : contact.pairs()) pairs.insert({p.edges, p.v[0], p.v[1], p.v[2], p.v[3]});
+    return pairs;
+  };
+  const auto check = [&](const std::vector<std::size_t>& dropped, std::int64_t searches, std::int64_t refreshes) {
+    std::vector<Cloth> moved = cloths;
+    for (Cloth& cloth : moved) cloth.state.previousPosition = cloth.state.position;
+    std::vector<SolverScratch> scratch(moved.size());
+    Workers workers(1);
+    contact::SelfContact contact;
+    contact.solve(moved, scratch, settings.selfCollision, 1, 1, workers);
+    const std::size_t before = contact.pairs().size();
+    for (const std::size_t i : dropped) moved[1].state.position[i].y = 0.007;
+    contact.finish(moved, settings.selfCollision, workers);
+    EXPECT_EQ(contact.stats().searches, searches);
+    EXPECT_EQ(contact.stats().refreshes, refreshes);
+    EXPECT_EQ(contact.stats().fallbacks, 0);
+    const Listed after = listed(contact);
+    EXPECT_GT(after.size(), before);
+    // A search from where the substep began to where the particles are now.
+    contact::SelfContact fresh;
+    fresh.solve(moved, scratch, settings.selfCollision, 1, 1, workers);
+    EXPECT_EQ(after, listed(fresh));
+  };
+  check({24}, 1, 1);  // the middle of the upper sheet: one particle of 130, a refresh
+  std::vector<std::size_t> many;
+  for (std::size_t i = 0; i < 20; ++i) many.push_back(i + 14);  // 20 particles: a search
+  check(many, 2, 0);
+}
+
 // A triangle stretched past ten times its rest size is left out of self-contact only where it is
 // also longer than its whole cloth at rest (a patch flung far, whose box would pair it with
 // everything on its way). On a fine lattice, where a twist winds the cloth round a grip,

@@ -151,6 +151,7 @@ nlohmann::json stateDocument(const Scene& scene, const sim::World& world) {
                           {{"pairs", contact.pairs},
                            {"pushed", contact.pushed},
                            {"searches", contact.searches},
+                           {"refreshes", contact.refreshes},
                            {"tested", contact.tested},
                            {"triangleTests", contact.triangleTests},
                            {"boxTests", contact.boxTests},

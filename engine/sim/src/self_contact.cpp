@@ -36,6 +36,9 @@ constexpr Real kLeverage = 0.25;
 // than its cloth at rest too, it takes none: findPairs).
 constexpr Real kTorn = 10.0;
 
+// Where more than one particle in this many leaves its box in the fail-safe, the pairs are found
+// again by a search; fewer, by pairing again what their primitives' boxes overlap (a refresh).
+constexpr std::size_t kStraysForSearch = 8;
 // Triangles a leaf of the broad phase's tree holds at most.
 constexpr std::size_t kLeafTriangles = 2;
 // Pairs of leaves a thread takes at a time when it lists their primitives' pairs.
@@ -150,7 +153,7 @@ std::size_t SelfContact::bytes() const {
                       b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
                       b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) +
                       b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) +
-                      b(made0_) + b(madeX_);
+                      b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(everyone_) + b(walk_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
   for (const std::vector<Pair>& found : found_) total += b(found);
@@ -351,13 +354,82 @@ void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<Sol
   }
 }
 
+// A triangle or edge stretched past kTorn times its rest size and longer than its whole cloth at
+// rest is no cloth any more (a finger flung its patch 100 m): it takes no part, or its box would
+// pair it with everything in between. (Not by its rest size alone: on a fine lattice, where a twist
+// winds the cloth round a grip, self-contact holds some of the grip's particles back while the
+// rest move on, the links between them stretch ten times over within a few centimetres, and
+// those triangles passed through the layers.)
+bool SelfContact::torn(const std::uint32_t* v, int count) const {
+  const auto longest = [&](const std::vector<Vec3>& x) {
+    Real most = 0.0;
+    for (int i = 0; i < count; ++i) {
+      const Vec3 d = x[v[i]] - x[v[(i + 1) % count]];
+      most = std::max(most, glm::dot(d, d));
+    }
+    return most;
+  };
+  return longest(x_) > std::max(kTorn * kTorn * longest(rest_), clothSize_[clothOf_[v[0]]]) + 4.0 * grow_ * grow_;
+}
+
+void SelfContact::boxPrimitive(std::size_t k) {
+  const std::size_t n = x_.size(), nt = triangles_.size();
+  const bool triangle = k < n + nt;
+  const std::uint32_t* v = triangle ? &triangles_[k - n][0] : &edges_[k - n - nt][0];
+  const int count = triangle ? 3 : 2;
+  if (torn(v, count)) {
+    lower_[k] = Vec3(std::numeric_limits<Real>::max());
+    upper_[k] = Vec3(std::numeric_limits<Real>::lowest());
+  } else {
+    lower_[k] = lower_[v[0]];
+    upper_[k] = upper_[v[0]];
+    for (int i = 1; i < count; ++i) {
+      lower_[k] = glm::min(lower_[k], lower_[v[i]]);
+      upper_[k] = glm::max(upper_[k], upper_[v[i]]);
+    }
+  }
+  // As the tree keeps it: single precision, rounded outwards.
+  boxLower_[k] = below(lower_[k]);
+  boxUpper_[k] = above(upper_[k]);
+}
+
+// Whether the two primitives' boxes lie apart along `axis` (the line between their centres): the
+// hull of the first `split` corners' boxes and that of the rest. Boxes that overlap
+// may still: a vertex's box inside a tilted triangle's box, a layer above it. Then, as for boxes
+// that do not overlap, while every particle keeps half a `distance` inside its box the two stay
+// at least `distance` apart (each hull shrinks by half a distance along the axis); so the pair is
+// not listed. Only where they are apart beyond rounding: the margin grows with the coordinates.
+bool SelfContact::apartBoxes(const std::uint32_t* corners, int split, Vec3 axis) const {
+  const Real length = glm::length(axis);
+  if (!(length > 0.0)) return false;
+  axis /= length;
+  const Vec3 size = glm::abs(axis);
+  Real lo[2] = {std::numeric_limits<Real>::max(), std::numeric_limits<Real>::max()};
+  Real hi[2] = {std::numeric_limits<Real>::lowest(), std::numeric_limits<Real>::lowest()};
+  Real scale = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 centre = (lower_[corners[k]] + upper_[corners[k]]) * 0.5;
+    const Real half = glm::dot(upper_[corners[k]] - lower_[corners[k]], size) * 0.5;
+    const Real at = glm::dot(centre, axis);
+    const int side = k < split ? 0 : 1;
+    lo[side] = std::min(lo[side], at - half);
+    hi[side] = std::max(hi[side], at + half);
+    // The dot products' rounding grows with the coordinates themselves, not with the projection.
+    scale = std::max(scale, glm::dot(glm::abs(centre), size) + half);
+  }
+  const Real margin = 1e-9 + 1e-12 * scale;
+  // Not apart unless every figure is finite (min and max pass a NaN by).
+  if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + margin)) return false;
+  return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
+}
+
 void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   const std::size_t n = x_.size(), nt = triangles_.size(), ne = edges_.size();
   // Boxes: each particle's motion, from x0 on for `ahead` times its motion in this substep (the
   // substeps left in the step: the pairs then serve for all of them while the particles keep
   // within), grown by `distance`, so that two boxes overlap wherever two primitives may come within
   // twice that. The solve may push a particle up to `distance` beyond, before the pairs must be found
-  // again (SelfContact::withinBoxes).
+  // again (SelfContact::strays).
   const Real grow = distance;
   lower_.resize(n + nt + ne);
   upper_.resize(n + nt + ne);
@@ -366,52 +438,14 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
     upper_[i] = glm::max(glm::max(x0_[i], x_[i]), to) + grow;
   }
-  // A triangle or edge stretched past kTorn times its rest size and longer than its whole cloth at
-  // rest is no cloth any more (a finger flung its patch 100 m): it takes no part, or its box would
-  // pair it with everything in between. (Not by its rest size alone: on a fine lattice, where a twist
-  // winds the cloth round a grip, self-contact holds some of the grip's particles back while the
-  // rest move on, the links between them stretch ten times over within a few centimetres, and
-  // those triangles passed through the layers.)
-  const auto longest = [&](const std::vector<Vec3>& x, const std::uint32_t* v, int count) {
-    Real most = 0.0;
-    for (int i = 0; i < count; ++i) {
-      const Vec3 d = x[v[i]] - x[v[(i + 1) % count]];
-      most = std::max(most, glm::dot(d, d));
-    }
-    return most;
-  };
-  const auto torn = [&](const std::uint32_t* v, int count) {
-    return longest(x_, v, count) >
-           std::max(kTorn * kTorn * longest(rest_, v, count), clothSize_[clothOf_[v[0]]]) + 4.0 * grow * grow;
-  };
-  const Vec3 none(std::numeric_limits<Real>::max());
-  for (std::size_t t = 0; t < nt; ++t) {
-    const glm::uvec3 v = triangles_[t];
-    if (torn(&triangles_[t][0], 3)) {
-      lower_[n + t] = none;
-      upper_[n + t] = -none;
-      continue;
-    }
-    lower_[n + t] = glm::min(glm::min(lower_[v[0]], lower_[v[1]]), lower_[v[2]]);
-    upper_[n + t] = glm::max(glm::max(upper_[v[0]], upper_[v[1]]), upper_[v[2]]);
-  }
-  for (std::size_t e = 0; e < ne; ++e) {
-    const glm::uvec2 v = edges_[e];
-    if (torn(&edges_[e][0], 2)) {
-      lower_[n + nt + e] = none;
-      upper_[n + nt + e] = -none;
-      continue;
-    }
-    lower_[n + nt + e] = glm::min(lower_[v[0]], lower_[v[1]]);
-    upper_[n + nt + e] = glm::max(upper_[v[0]], upper_[v[1]]);
-  }
-  // The boxes as the tree keeps them: single precision, rounded outwards.
+  grow_ = grow;
   boxLower_.resize(n + nt + ne);
   boxUpper_.resize(n + nt + ne);
-  for (std::size_t i = 0; i < n + nt + ne; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     boxLower_[i] = below(lower_[i]);
     boxUpper_[i] = above(upper_[i]);
   }
+  for (std::size_t k = n; k < n + nt + ne; ++k) boxPrimitive(k);
   fitTree();
   ++stats_.searches;
 
@@ -455,34 +489,8 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     }
   }
 
-  // Whether the two primitives' boxes lie apart along `axis` (the line between their centres): the
-  // hull of the first `split` corners' boxes and that of the rest. Boxes that overlap
-  // may still: a vertex's box inside a tilted triangle's box, a layer above it. Then, as for boxes
-  // that do not overlap, while every particle keeps half a `distance` inside its box the two stay
-  // at least `distance` apart (each hull shrinks by half a distance along the axis); so the pair is
-  // not listed. Only where they are apart beyond rounding: the margin grows with the coordinates.
   const auto apart = [&](const std::uint32_t* corners, int split, Vec3 axis) {
-    const Real length = glm::length(axis);
-    if (!(length > 0.0)) return false;
-    axis /= length;
-    const Vec3 size = glm::abs(axis);
-    Real lo[2] = {std::numeric_limits<Real>::max(), std::numeric_limits<Real>::max()};
-    Real hi[2] = {std::numeric_limits<Real>::lowest(), std::numeric_limits<Real>::lowest()};
-    Real scale = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      const Vec3 centre = (lower_[corners[k]] + upper_[corners[k]]) * 0.5;
-      const Real half = glm::dot(upper_[corners[k]] - lower_[corners[k]], size) * 0.5;
-      const Real at = glm::dot(centre, axis);
-      const int side = k < split ? 0 : 1;
-      lo[side] = std::min(lo[side], at - half);
-      hi[side] = std::max(hi[side], at + half);
-      // The dot products' rounding grows with the coordinates themselves, not with the projection.
-      scale = std::max(scale, glm::dot(glm::abs(centre), size) + half);
-    }
-    const Real margin = 1e-9 + 1e-12 * scale;
-    // Not apart unless every figure is finite (min and max pass a NaN by).
-    if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + margin)) return false;
-    return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
+    return apartBoxes(corners, split, axis);
   };
 
   // Their primitives, in parallel: blocks of leaf pairs to whichever thread is free (a crumpled
@@ -521,7 +529,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (c[0] == v || c[1] == v || c[2] == v) continue;
               const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
               if (apart(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) continue;
-              vertexTriangle.push_back({{corners[0], corners[1], corners[2], corners[3]}, v, t, kFar, false});
+              vertexTriangle.push_back({{corners[0], corners[1], corners[2], corners[3]}, v, t, kFar, false, false});
             }
           }
         };
@@ -544,8 +552,12 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
               const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
               if (apart(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
-              edgeEdge.push_back(
-                  {{corners[0], corners[1], corners[2], corners[3]}, std::min(e, f), std::max(e, f), kFar, true});
+              edgeEdge.push_back({{corners[0], corners[1], corners[2], corners[3]},
+                                  std::min(e, f),
+                                  std::max(e, f),
+                                  kFar,
+                                  true,
+                                  false});
             }
           }
         }
@@ -561,6 +573,126 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   }
   for (const std::int64_t compared : boxTests_) tests += compared;
   stats_.boxTests += tests;
+}
+
+void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
+  // Each stray particle's box: its motion in this substep as it now is, grown as a search grows
+  // it. The triangles and edges it is a corner of are boxed again; every pair of these primitives
+  // goes, and each is paired anew with whatever its box overlaps, as a search would pair it. The
+  // other pairs a search would find are already listed: their boxes are as they were.
+  const std::size_t n = x_.size(), nt = triangles_.size(), ne = edges_.size();
+  ++stats_.refreshes;
+  affected_.assign(n + nt + ne, 0);
+  for (const std::uint32_t i : strays) {
+    affected_[i] = 1;
+    lower_[i] = glm::min(x0_[i], x_[i]) - grow_;
+    upper_[i] = glm::max(x0_[i], x_[i]) + grow_;
+    boxLower_[i] = below(lower_[i]);
+    boxUpper_[i] = above(upper_[i]);
+    for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) affected_[n + vertexTriangles_[k]] = 1;
+  }
+  for (std::size_t e = 0; e < ne; ++e) {
+    if (affected_[edges_[e][0]] || affected_[edges_[e][1]]) affected_[n + nt + e] = 1;
+  }
+  for (std::size_t k = n; k < n + nt + ne; ++k) {
+    if (affected_[k]) boxPrimitive(k);
+  }
+  std::erase_if(pairs_, [&](const Pair& p) {
+    return p.edges ? affected_[n + nt + p.first] || affected_[n + nt + p.second]
+                   : affected_[p.first] || affected_[n + p.second];
+  });
+  fitTree();
+
+  std::int64_t compared = 0;
+  // The leaves whose boxes overlap box k, in the tree's order.
+  const auto leaves = [&](std::size_t k, auto&& visit) {
+    walk_.clear();
+    if (!nodes_.empty()) walk_.push_back(0);
+    while (!walk_.empty()) {
+      const Node& node = nodes_[walk_.back()];
+      walk_.pop_back();
+      ++compared;
+      if (!overlap(node.lower, node.upper, boxLower_[k], boxUpper_[k])) continue;
+      if (node.right == kNone) {
+        visit(node.left);
+      } else {
+        walk_.push_back(node.right);
+        walk_.push_back(node.left);
+      }
+    }
+  };
+  // Listed as a search lists them, far (measured by the fail-safe if it must be), and marked new.
+  const auto vertexTriangle = [&](std::uint32_t v, std::uint32_t t) {
+    ++compared;
+    if (!overlap(boxLower_[v], boxUpper_[v], boxLower_[n + t], boxUpper_[n + t])) return;
+    const glm::uvec3 c = triangles_[t];
+    if (c[0] == v || c[1] == v || c[2] == v) return;
+    const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
+    if (apartBoxes(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) return;
+    pairs_.push_back({{corners[0], corners[1], corners[2], corners[3]}, v, t, kFar, false, true});
+  };
+  // A stray vertex against every triangle; a triangle with a stray corner against every vertex
+  // but the stray ones (paired from their side); an edge with a stray end against every edge, and
+  // against another such edge once.
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (!affected_[v]) continue;
+    leaves(v, [&](std::uint32_t leaf) {
+      for (std::uint32_t j = leafTriangleStart_[leaf]; j < leafTriangleStart_[leaf + 1]; ++j)
+        vertexTriangle(v, leafTriangles_[j]);
+    });
+  }
+  for (std::uint32_t t = 0; t < nt; ++t) {
+    if (!affected_[n + t]) continue;
+    leaves(n + t, [&](std::uint32_t leaf) {
+      for (std::uint32_t j = leafVertexStart_[leaf]; j < leafVertexStart_[leaf + 1]; ++j) {
+        if (!affected_[leafVertices_[j]]) vertexTriangle(leafVertices_[j], t);
+      }
+    });
+  }
+  for (std::uint32_t e = 0; e < ne; ++e) {
+    if (!affected_[n + nt + e]) continue;
+    const glm::vec3 lo = boxLower_[n + nt + e], hi = boxUpper_[n + nt + e];
+    leaves(n + nt + e, [&](std::uint32_t leaf) {
+      for (std::uint32_t j = leafEdgeStart_[leaf]; j < leafEdgeStart_[leaf + 1]; ++j) {
+        const std::uint32_t f = leafEdges_[j];
+        if (f == e || (affected_[n + nt + f] && f < e)) continue;
+        ++compared;
+        if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
+        const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
+        if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
+        const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
+        if (apartBoxes(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
+        pairs_.push_back(
+            {{corners[0], corners[1], corners[2], corners[3]}, std::min(e, f), std::max(e, f), kFar, true, true});
+      }
+    });
+  }
+  stats_.boxTests += compared;
+}
+
+const std::vector<std::uint32_t>& SelfContact::strays(const std::vector<std::uint32_t>& candidates, Real margin) {
+  strays_.clear();
+  for (const std::uint32_t i : candidates) {
+    const Vec3 lo = lower_[i] + margin, hi = upper_[i] - margin;
+    for (const Vec3& x : {x0_[i], x_[i]}) {
+      if (glm::any(glm::lessThan(x, lo)) || glm::any(glm::greaterThan(x, hi))) {
+        strays_.push_back(i);
+        break;
+      }
+    }
+  }
+  return strays_;
+}
+
+bool SelfContact::keepPairs(const std::vector<std::uint32_t>& candidates, Real distance, Workers& workers) {
+  if (strays(candidates, 0.0).empty()) return false;
+  if (strays_.size() * kStraysForSearch > x_.size()) {
+    findPairs(distance, 1.0, workers);
+    measurePairs(distance, workers);
+  } else {
+    refresh(strays_);
+  }
+  return true;
 }
 
 bool SelfContact::stillFar(const Pair& p) const {
@@ -646,6 +778,7 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
     measured.swap(measured_[static_cast<std::size_t>(thread)]);
     for (std::size_t i = begin; i < end; ++i) {
       Pair& pair = pairs_[i];
+      pair.refreshed = false;
       if (apartAlongCentres(pair, distance)) {
         pair.contact = kFar;
       } else {
@@ -758,24 +891,13 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
   stats_.pushed = pushed;
 }
 
-bool SelfContact::withinBoxes(Real margin) const {
-  for (std::size_t i = 0; i < x_.size(); ++i) {
-    const Vec3 lo = lower_[i] + margin, hi = upper_[i] - margin;
-    for (const Vec3& x : {x0_[i], x_[i]}) {
-      if (glm::any(glm::lessThan(x, lo)) || glm::any(glm::greaterThan(x, hi))) return false;
-    }
-  }
-  return true;
-}
-
 void SelfContact::failSafe(Real distance, Workers& workers) {
-  // The boxes must hold every particle's whole motion: where the solve took one beyond them, the
+  // The boxes must hold every particle's whole motion: where the solve took one beyond its box, the
   // pairs are found again for the motion as it now is.
-  if (!withinBoxes(0.0)) {
-    findPairs(distance, 1.0, workers);
-    measurePairs(distance, workers);
-  }
   const std::size_t n = x_.size();
+  everyone_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) everyone_[i] = i;
+  keepPairs(everyone_, distance, workers);
   triangleMoved_.assign(triangles_.size(), 0);
   if (inZone_.size() != n) inZone_.assign(n, 0);
   if (stays_.size() != n) stays_.assign(n, 0);
@@ -942,11 +1064,13 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
         // are by more than kProofMargin while no corner has moved a quarter of the difference
         // since (each side's reach along the line grows by its move; the quarter leaves room for
         // rounding), which is cheaper to tell.
-        if (stillFar(p) || apartAlongCentres(p, kProofMargin)) continue;
+        if ((!p.refreshed && stillFar(p)) || apartAlongCentres(p, kProofMargin)) continue;
         p.contact = static_cast<std::uint32_t>(contacts_.size());
         contacts_.push_back(measure(p, distance));
       }
-      if (contacts_[p.contact].gap0 > std::sqrt(m) + kProofMargin) continue;  // proven apart all the way
+      // Proven apart all the way: by the gap at x0 against the relative motion, or (a pair near at
+      // x0 whose corners moved apart) along the line between the centres.
+      if (contacts_[p.contact].gap0 > std::sqrt(m) + kProofMargin || apartAlongCentres(p, kProofMargin)) continue;
       ++stats_.tested;
       eachTest(p, [&](std::uint32_t s, std::uint32_t t) {
         tests.push_back((static_cast<std::uint64_t>(std::min(s, t)) << 32) | std::max(s, t));
@@ -1093,19 +1217,10 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     }
     // A zone's move may take a member out of its box (the zone's mean motion is larger than the
     // member's own): the pairs then no longer hold every primitive it may meet on its way from x0,
-    // so they are found again for the motion as it now is, and all tested. (The wide twist,
-    // assets/cases/twist-wide.json, left 3 pairs through each other at 24 x 24 before.)
-    everyPair = false;
-    for (const std::uint32_t i : members) {
-      if (glm::any(glm::lessThan(x_[i], lower_[i])) || glm::any(glm::greaterThan(x_[i], upper_[i]))) {
-        everyPair = true;
-        break;
-      }
-    }
-    if (everyPair) {
-      findPairs(distance, 1.0, workers);
-      measurePairs(distance, workers);
-    }
+    // so they are found again for the motion as it now is (refreshed, or searched where many
+    // left), and all tested. (The wide twist, assets/cases/twist-wide.json, left 3 pairs through
+    // each other at 24 x 24 before.)
+    everyPair = keepPairs(members, distance, workers);
   }
   for (Made* m : {&at0, &atX}) {
     for (const std::uint32_t t : m->which) m->slot[t] = kNone;
@@ -1152,8 +1267,12 @@ void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& 
   gather(cloths, &scratch, nullptr);
   // The pairs found at a substep serve the rest of its step while every particle, at x0 and now,
   // keeps half a `distance` inside its box: two primitives within `distance` of each other are then
-  // still among them.
-  if (fresh || distance_ != settings.distance || !withinBoxes(0.5 * settings.distance)) {
+  // still among them. (A refresh here, of the particles that did not, would find fewer pairs again,
+  // but the boxes of the others, left from earlier, larger motion, then pair them with more: in the
+  // crumple at 64 x 64 twice the memory for a third less time.)
+  everyone_.resize(x_.size());
+  for (std::uint32_t i = 0; i < x_.size(); ++i) everyone_[i] = i;
+  if (fresh || distance_ != settings.distance || !strays(everyone_, 0.5 * settings.distance).empty()) {
     // Looking ahead pays while the motion is smooth enough for the pairs to serve again; where they
     // did not, the next boxes hold this substep's motion only.
     findPairs(settings.distance, reused_ ? static_cast<Real>(std::max(substepsLeft, 1)) : 1.0, workers);

@@ -20,7 +20,8 @@
 //    relative motion, removed up to `friction` times the push.
 // 3. Fail-safe. Along the straight path from x0 to x, two primitives at x0-distance g can only
 //    meet if their corners' relative motion m (the largest |dx_i - dx_j| between a corner of one
-//    and of the other) reaches g. A pair with m < g is proven apart. For the others, the triangles
+//    and of the other) reaches g. A pair with m < g is proven apart, as is one whose corners' hulls
+//    over the substep lie apart along the line between its centres. For the others, the triangles
 //    around them are tested exactly (intersections.hpp's test, on the 2^-24 m grid) at x and at x0,
 //    each pair of triangles once a round; where two of them intersect at x and did not at x0, their
 //    free corners join an impact zone, which moves rigidly from x0 by its mass-weighted mean motion
@@ -31,8 +32,10 @@
 //    A pair still through with its corners in one zone already (a translation the exact grid's
 //    rounding does not let it survive) stops that zone at x0 for the substep, and what passes
 //    through a zone that stays joins it and stays too. Each round joins or stops something, so it
-//    ends; where nothing is left to join or stop, the whole substep goes back to x0. Where a zone's
-//    move takes a member out of its box, the pairs are found again first.
+//    ends; where nothing is left to join or stop, the whole substep goes back to x0. Where the
+//    contacts or a zone's move take particles out of their boxes, the pairs are found again first:
+//    where fewer than one in eight left, those of the triangles and edges they are corners of only,
+//    each by its box (a refresh: what a search would find), else by a search.
 //
 // A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
 // it would without self-contact. Deterministic whatever the number of threads: the tree's walk lists
@@ -80,6 +83,9 @@ class SelfContact {
     // began, so not measured and not pushed.
     std::uint32_t contact;
     bool edges;
+    // Listed by a refresh in the fail-safe, after the pairs were measured: not measured with them
+    // (so SelfContact::stillFar says nothing of it).
+    bool refreshed;
   };
   static constexpr std::uint32_t kFar = 0xffffffffu;
   // A pair measured at x0 (those not far): what the sweeps push along.
@@ -116,7 +122,18 @@ class SelfContact {
   bool stillFar(const Pair& pair) const;
   void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
   void failSafe(Real distance, Workers& workers);
-  bool withinBoxes(Real margin) const;
+  // Of `candidates`, the particles not `margin` inside their boxes at x0 and now (in strays_).
+  const std::vector<std::uint32_t>& strays(const std::vector<std::uint32_t>& candidates, Real margin);
+  // In the fail-safe: the pairs kept whole for the motion as it now is, where any of `candidates`
+  // left its box: by a refresh of the few that did (their primitives paired again by their boxes,
+  // the particles' boxes now their motion), or a search where many did; whether either was needed.
+  bool keepPairs(const std::vector<std::uint32_t>& candidates, Real distance, Workers& workers);
+  void refresh(const std::vector<std::uint32_t>& strays);
+  // A triangle's or edge's box from its corners' (k: its index among the boxes), or none where it
+  // is torn; whether it is; whether two primitives' boxes lie apart along `axis` (findPairs).
+  void boxPrimitive(std::size_t k);
+  bool torn(const std::uint32_t* corners, int count) const;
+  bool apartBoxes(const std::uint32_t* corners, int split, Vec3 axis) const;
 
   std::uint64_t meshVersion_ = 0;
   std::size_t meshParticles_ = 0;
@@ -143,6 +160,11 @@ class SelfContact {
   std::vector<Plane> planes_;                   // the collider contacts of this substep
   std::vector<Vec3> lower_, upper_;             // boxes of the particles, triangles, edges: in that order
   std::vector<glm::vec3> boxLower_, boxUpper_;  // the same in single precision, rounded outwards
+  Real grow_ = 0.0;                             // how far the boxes reach beyond the motion, m
+  // A refresh's primitives (particles, triangles, edges, flagged), the particles that left their
+  // boxes, every particle's index, and the tree's walk.
+  std::vector<std::uint8_t> affected_;
+  std::vector<std::uint32_t> strays_, everyone_, walk_;
   // The broad phase's tree (a bounding-volume hierarchy), built with the mesh from the rest shape:
   // cloth by cloth, then halving the triangles at the median along the longest side of their rest
   // centroids, down to leaves of at most kLeafTriangles items (triangles, and particles in no

@@ -68,6 +68,7 @@ struct SelfContactStats {
   std::int64_t zoned = 0;          // since made: particles the fail-safe moved as one body with others (a zone)
   std::int64_t fallbacks = 0;      // since made: substeps where a zone stayed at x0, or all went back there
   std::int64_t searches = 0;       // since made: broad-phase searches (the pairs found anew)
+  std::int64_t refreshes = 0;      // since made: the pairs of particles that strayed found anew, not all
   std::int64_t triangleTests = 0;  // since made: exact triangle-triangle tests by the fail-safe
   std::int64_t boxTests = 0;       // since made: boxes the broad phase compared (its tree's nodes and primitives)
 };
