@@ -31,8 +31,9 @@ inline constexpr double kStepBudget = 2.0e5;
 // tells before the world moves: the shipped gestures on the desk find up to 99 pairs a particle
 // (spread; tear 92, crumple 77), a sheet torn to shreds and whipping about found 310 to 550, and
 // its first step took 16 s under the sanitizers for 1,776 particles (docs/fuzzing.md, Findings).
-// So a substep of it counts as this many sweeps a particle: a world that collides with itself is
-// stepped once only at some 950 particle-substeps a step or fewer, twice at 475. (At 100, a 25 x 24
+// So a substep of it counts as this many sweeps a particle (at least: selfContactSweeps): a world
+// that collides with itself is stepped once only at some 950 particle-substeps a step or fewer,
+// twice at 475. (At 100, a 25 x 24
 // sheet whose pins lie metres from where it was built, stretched in its first step, was stepped once:
 // 1.5 s in Release, past 10 s in the fuzz build; docs/fuzzing.md, Findings.)
 inline constexpr double kSelfContactSweeps = 200.0;
@@ -109,6 +110,29 @@ inline double estimatedParticles(const sim::WorldSettings& world) {
   return total;
 }
 
+// Self-contact's pairs a particle grow with the square of its distance against the spacing (the
+// neighbours within reach in a layer; more in a pile). The desk keeps the distance under a fifth of
+// its spacing (0.19 at 24 x 24), where a substep of self-contact counts kSelfContactSweeps; beyond,
+// that times the square of the ratio to a fifth. (A 24 x 24 sheet torn to shreds in its first step
+// at 2 cm, 0.46 of its 4.3 cm spacing, listed 326 pairs a particle: 0.8 s in Release and 9 s under
+// the sanitizers for that one step; docs/fuzzing.md, Findings.)
+inline double selfContactSweeps(const sim::WorldSettings& world) {
+  double spacing = HUGE_VAL;
+  for (const sim::ClothSettings& cloth : world.cloths) {
+    if (cloth.outline) {
+      spacing = std::min(spacing, cloth.outline->spacing);
+      continue;
+    }
+    const sim::LatticeSpec& grid = cloth.lattice;
+    if (grid.columns > 1) spacing = std::min(spacing, grid.width / (grid.columns - 1));
+    if (grid.rows > 1) spacing = std::min(spacing, grid.height / (grid.rows - 1));
+  }
+  const double ratio = world.selfCollision.distance / (0.2 * spacing);
+  // (Not a number, or a spacing of nothing: as many as the cap.)
+  const double factor = ratio <= 1.0 ? 1.0 : std::min(ratio * ratio, 1.0e6);
+  return kSelfContactSweeps * (std::isnan(factor) ? 1.0e6 : factor);
+}
+
 // How many of `wanted` steps fit the budget for a world of `particles` particles.
 inline int affordableSteps(const sim::WorldSettings& world, double particles, int wanted) {
   const sim::SolverSettings& s = world.solver;
@@ -116,7 +140,7 @@ inline int affordableSteps(const sim::WorldSettings& world, double particles, in
   if (s.model == sim::Model::position) {
     sweeps = std::max(1, s.iterations) * (1.0 + (s.lines ? 2.0 + s.extraLineSteps : 0.0)) + 1.0;
   }
-  if (world.selfCollision.enabled) sweeps += kSelfContactSweeps;
+  if (world.selfCollision.enabled) sweeps += selfContactSweeps(world);
   const double perStep = std::max(1.0, particles) * std::max(1, s.substeps) * sweeps;
   return static_cast<int>(std::clamp(std::floor(kStepBudget / perStep), 0.0, static_cast<double>(wanted)));
 }
