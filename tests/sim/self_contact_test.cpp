@@ -345,8 +345,10 @@ TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
     contact::SelfContact contact;
     contact.solve(copy, scratch, settings.selfCollision, 1, 1, workers);
     std::vector<std::tuple<bool, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> pairs;
-    for (const contact::SelfContact::Pair& p : contact.pairs())
-      pairs.emplace_back(p.edges, p.v[0], p.v[1], p.v[2], p.v[3]);
+    for (const contact::SelfContact::Pair& p : contact.pairs()) {
+      const std::array<std::uint32_t, 4> v = contact.corners(p);
+      pairs.emplace_back(p.edges, v[0], v[1], v[2], v[3]);
+    }
     return pairs;
   };
   const auto pairs = listed(1);
@@ -417,7 +419,10 @@ TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
   using Listed = std::set<std::tuple<bool, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>>;
   const auto listed = [](const contact::SelfContact& contact) {
     Listed pairs;
-    for (const contact::SelfContact::Pair& p : contact.pairs()) pairs.insert({p.edges, p.v[0], p.v[1], p.v[2], p.v[3]});
+    for (const contact::SelfContact::Pair& p : contact.pairs()) {
+      const std::array<std::uint32_t, 4> v = contact.corners(p);
+      pairs.insert({p.edges, v[0], v[1], v[2], v[3]});
+    }
     return pairs;
   };
   const auto check = [&](const std::vector<std::size_t>& dropped, std::int64_t searches, std::int64_t refreshes) {
@@ -471,7 +476,8 @@ TEST(SelfContact, ATriangleStretchedTenfoldButShorterThanItsClothStillTakesPart)
     for (const contact::SelfContact::Pair& p : contact.pairs()) {
       // The corner as a triangle's corner or an edge's end (as a lone vertex it is far from all).
       const int from = p.edges ? 0 : 1;
-      for (int k = from; k < 4; ++k) with += p.v[k] == 0 ? 1 : 0;
+      const std::array<std::uint32_t, 4> v = contact.corners(p);
+      for (int k = from; k < 4; ++k) with += v[k] == 0 ? 1 : 0;
     }
     return with;
   };

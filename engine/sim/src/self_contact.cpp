@@ -529,7 +529,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (c[0] == v || c[1] == v || c[2] == v) continue;
               const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
               if (apart(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) continue;
-              vertexTriangle.push_back({{corners[0], corners[1], corners[2], corners[3]}, v, t, kFar, false, false});
+              vertexTriangle.push_back({v, t, kFar, false, false});
             }
           }
         };
@@ -552,12 +552,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
               const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
               if (apart(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
-              edgeEdge.push_back({{corners[0], corners[1], corners[2], corners[3]},
-                                  std::min(e, f),
-                                  std::max(e, f),
-                                  kFar,
-                                  true,
-                                  false});
+              edgeEdge.push_back({std::min(e, f), std::max(e, f), kFar, true, false});
             }
           }
         }
@@ -629,7 +624,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
     if (c[0] == v || c[1] == v || c[2] == v) return;
     const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
     if (apartBoxes(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) return;
-    pairs_.push_back({{corners[0], corners[1], corners[2], corners[3]}, v, t, kFar, false, true});
+    pairs_.push_back({v, t, kFar, false, true});
   };
   // A stray vertex against every triangle; a triangle with a stray corner against every vertex
   // but the stray ones (paired from their side); an edge with a stray end against every edge, and
@@ -662,8 +657,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
         if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
         const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
         if (apartBoxes(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
-        pairs_.push_back(
-            {{corners[0], corners[1], corners[2], corners[3]}, std::min(e, f), std::max(e, f), kFar, true, true});
+        pairs_.push_back({std::min(e, f), std::max(e, f), kFar, true, true});
       }
     });
   }
@@ -698,8 +692,9 @@ bool SelfContact::keepPairs(const std::vector<std::uint32_t>& candidates, Real d
 bool SelfContact::stillFar(const Pair& p) const {
   const Real slack = 0.25 * (measuredDistance_ - kProofMargin);
   if (!(slack > 0.0)) return false;
+  const std::array<std::uint32_t, 4> v = corners(p);
   for (int k = 0; k < 4; ++k) {
-    const Vec3 d = x_[p.v[k]] - xMeasured_[p.v[k]];
+    const Vec3 d = x_[v[k]] - xMeasured_[v[k]];
     if (!(glm::dot(d, d) <= slack * slack)) return false;
   }
   return true;
@@ -709,7 +704,7 @@ bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
   // Along the line between the two primitives' centres at x0: the hull of one's corners at x0 and
   // at x against the other's. Apart there, they are apart all along the straight paths from x0 to
   // x (each corner's path lies between its two ends), by more than `margin`.
-  const std::uint32_t* v = p.v;
+  const std::array<std::uint32_t, 4> v = corners(p);
   const Vec3 axis = p.edges ? (x0_[v[0]] + x0_[v[1]]) * 0.5 - (x0_[v[2]] + x0_[v[3]]) * 0.5
                             : x0_[v[0]] - (x0_[v[1]] + x0_[v[2]] + x0_[v[3]]) * (1.0 / 3.0);
   const int split = p.edges ? 2 : 1;
@@ -739,7 +734,7 @@ bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
 }
 
 SelfContact::Contact SelfContact::measure(const Pair& pair, Real distance) const {
-  const std::uint32_t* v = pair.v;
+  const std::array<std::uint32_t, 4> v = corners(pair);
   Contact contact;
   const Weights weights = pair.edges ? edgeEdgeWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]])
                                      : vertexTriangleWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
@@ -1052,9 +1047,10 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
       // The largest relative motion of a corner of one against a corner of the other.
       Real m = 0.0;
       const int split = p.edges ? 2 : 1;
+      const std::array<std::uint32_t, 4> v = corners(p);
       for (int i = 0; i < split; ++i) {
         for (int j = split; j < 4; ++j) {
-          const Vec3 d = (x_[p.v[i]] - x0_[p.v[i]]) - (x_[p.v[j]] - x0_[p.v[j]]);
+          const Vec3 d = (x_[v[i]] - x0_[v[i]]) - (x_[v[j]] - x0_[v[j]]);
           m = std::max(m, glm::dot(d, d));
         }
       }

@@ -44,6 +44,7 @@
 // solved in it; the pairs' contacts are made in each thread's run of them, joined in that order.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <utility>
@@ -75,10 +76,9 @@ class SelfContact {
   const SelfContactStats& stats() const { return stats_; }
   std::size_t bytes() const;
 
-  // What the broad phase lists: 32 bytes, as many as a hundred a particle in a crumpled pile.
+  // What the broad phase lists: 16 bytes, as many as a hundred a particle in a crumpled pile.
   struct Pair {
-    std::uint32_t v[4];           // vertex-triangle: the vertex, the triangle's corners; edge-edge: a0 a1 b0 b1
-    std::uint32_t first, second;  // vertex and triangle, or the two edges
+    std::uint32_t first, second;  // vertex and triangle, or the two edges (the lower first)
     // Its contact (an index into contacts_), or kFar: apart by more than the distance as the solve
     // began, so not measured and not pushed.
     std::uint32_t contact;
@@ -101,6 +101,16 @@ class SelfContact {
   // The pairs last found (by a substep's search, its fail-safe's, or settle's), in the order they
   // are solved (for tests).
   const std::vector<Pair>& pairs() const { return pairs_; }
+  // A pair's four particles: vertex-triangle, the vertex and the triangle's corners; edge-edge, the
+  // first edge's ends and the second's.
+  std::array<std::uint32_t, 4> corners(const Pair& pair) const {
+    if (pair.edges) {
+      const glm::uvec2 a = edges_[pair.first], b = edges_[pair.second];
+      return {a[0], a[1], b[0], b[1]};
+    }
+    const glm::uvec3 t = triangles_[pair.second];
+    return {pair.first, t[0], t[1], t[2]};
+  }
 
  private:
   // Makes the mesh again if the topology changed; true if it did.
