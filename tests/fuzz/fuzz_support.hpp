@@ -33,9 +33,9 @@ inline constexpr double kStepBudget = 2.0e5;
 // its first step took 16 s under the sanitizers for 1,776 particles (docs/fuzzing.md, Findings).
 // So a substep of it counts as this many sweeps a particle (at least: selfContactSweeps): a world
 // that collides with itself is stepped once only at some 950 particle-substeps a step or fewer,
-// twice at 475. (At 100, a 25 x 24
-// sheet whose pins lie metres from where it was built, stretched in its first step, was stepped once:
-// 1.5 s in Release, past 10 s in the fuzz build; docs/fuzzing.md, Findings.)
+// twice at 475. (At 100, a 25 x 24 sheet whose pins lie metres from where it was built, stretched
+// in its first step, was stepped once: 1.5 s in Release, past 10 s in the fuzz build;
+// docs/fuzzing.md, Findings.)
 inline constexpr double kSelfContactSweeps = 200.0;
 
 inline std::string_view text(const std::uint8_t* data, std::size_t size) {

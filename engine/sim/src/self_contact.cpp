@@ -153,7 +153,7 @@ std::size_t SelfContact::bytes() const {
                       b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
                       b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) +
                       b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) +
-                      b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(everyone_) + b(walk_);
+                      b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
   for (const std::vector<Pair>& found : found_) total += b(found);
@@ -664,21 +664,26 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
   stats_.boxTests += compared;
 }
 
-const std::vector<std::uint32_t>& SelfContact::strays(const std::vector<std::uint32_t>& candidates, Real margin) {
+const std::vector<std::uint32_t>& SelfContact::strays(const std::vector<std::uint32_t>* candidates, Real margin) {
   strays_.clear();
-  for (const std::uint32_t i : candidates) {
+  const auto look = [&](std::uint32_t i) {
     const Vec3 lo = lower_[i] + margin, hi = upper_[i] - margin;
     for (const Vec3& x : {x0_[i], x_[i]}) {
       if (glm::any(glm::lessThan(x, lo)) || glm::any(glm::greaterThan(x, hi))) {
         strays_.push_back(i);
-        break;
+        return;
       }
     }
+  };
+  if (candidates) {
+    for (const std::uint32_t i : *candidates) look(i);
+  } else {
+    for (std::uint32_t i = 0; i < x_.size(); ++i) look(i);
   }
   return strays_;
 }
 
-bool SelfContact::keepPairs(const std::vector<std::uint32_t>& candidates, Real distance, Workers& workers) {
+bool SelfContact::keepPairs(const std::vector<std::uint32_t>* candidates, Real distance, Workers& workers) {
   if (strays(candidates, 0.0).empty()) return false;
   if (strays_.size() * kStraysForSearch > x_.size()) {
     findPairs(distance, 1.0, workers);
@@ -890,9 +895,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
   // The boxes must hold every particle's whole motion: where the solve took one beyond its box, the
   // pairs are found again for the motion as it now is.
   const std::size_t n = x_.size();
-  everyone_.resize(n);
-  for (std::uint32_t i = 0; i < n; ++i) everyone_[i] = i;
-  keepPairs(everyone_, distance, workers);
+  keepPairs(nullptr, distance, workers);
   triangleMoved_.assign(triangles_.size(), 0);
   if (inZone_.size() != n) inZone_.assign(n, 0);
   if (stays_.size() != n) stays_.assign(n, 0);
@@ -1216,7 +1219,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     // so they are found again for the motion as it now is (refreshed, or searched where many
     // left), and all tested. (The wide twist, assets/cases/twist-wide.json, left 3 pairs through
     // each other at 24 x 24 before.)
-    everyPair = keepPairs(members, distance, workers);
+    everyPair = keepPairs(&members, distance, workers);
   }
   for (Made* m : {&at0, &atX}) {
     for (const std::uint32_t t : m->which) m->slot[t] = kNone;
@@ -1266,9 +1269,7 @@ void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& 
   // still among them. (A refresh here, of the particles that did not, would find fewer pairs again,
   // but the boxes of the others, left from earlier, larger motion, then pair them with more: in the
   // crumple at 64 x 64 twice the memory for a third less time.)
-  everyone_.resize(x_.size());
-  for (std::uint32_t i = 0; i < x_.size(); ++i) everyone_[i] = i;
-  if (fresh || distance_ != settings.distance || !strays(everyone_, 0.5 * settings.distance).empty()) {
+  if (fresh || distance_ != settings.distance || !strays(nullptr, 0.5 * settings.distance).empty()) {
     // Looking ahead pays while the motion is smooth enough for the pairs to serve again; where they
     // did not, the next boxes hold this substep's motion only.
     findPairs(settings.distance, reused_ ? static_cast<Real>(std::max(substepsLeft, 1)) : 1.0, workers);

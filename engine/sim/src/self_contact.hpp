@@ -132,12 +132,13 @@ class SelfContact {
   bool stillFar(const Pair& pair) const;
   void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
   void failSafe(Real distance, Workers& workers);
-  // Of `candidates`, the particles not `margin` inside their boxes at x0 and now (in strays_).
-  const std::vector<std::uint32_t>& strays(const std::vector<std::uint32_t>& candidates, Real margin);
+  // Of `candidates` (every particle where null), those not `margin` inside their boxes at x0 and
+  // now (in strays_).
+  const std::vector<std::uint32_t>& strays(const std::vector<std::uint32_t>* candidates, Real margin);
   // In the fail-safe: the pairs kept whole for the motion as it now is, where any of `candidates`
   // left its box: by a refresh of the few that did (their primitives paired again by their boxes,
   // the particles' boxes now their motion), or a search where many did; whether either was needed.
-  bool keepPairs(const std::vector<std::uint32_t>& candidates, Real distance, Workers& workers);
+  bool keepPairs(const std::vector<std::uint32_t>* candidates, Real distance, Workers& workers);
   void refresh(const std::vector<std::uint32_t>& strays);
   // A triangle's or edge's box from its corners' (k: its index among the boxes), or none where it
   // is torn; whether it is; whether two primitives' boxes lie apart along `axis` (findPairs).
@@ -172,9 +173,9 @@ class SelfContact {
   std::vector<glm::vec3> boxLower_, boxUpper_;  // the same in single precision, rounded outwards
   Real grow_ = 0.0;                             // how far the boxes reach beyond the motion, m
   // A refresh's primitives (particles, triangles, edges, flagged), the particles that left their
-  // boxes, every particle's index, and the tree's walk.
+  // boxes, and the tree's walk.
   std::vector<std::uint8_t> affected_;
-  std::vector<std::uint32_t> strays_, everyone_, walk_;
+  std::vector<std::uint32_t> strays_, walk_;
   // The broad phase's tree (a bounding-volume hierarchy), built with the mesh from the rest shape:
   // cloth by cloth, then halving the triangles at the median along the longest side of their rest
   // centroids, down to leaves of at most kLeafTriangles items (triangles, and particles in no
