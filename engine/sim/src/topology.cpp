@@ -1196,10 +1196,17 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
   for (const ParticleIndex p : tips) {
     if (p < n0) line.joins[p] = 1;
   }
+  // A particle on the line counts within the swipe up to kOnLine spacings past either end, as it
+  // does off the plane: a swipe along edges that stops just short of a particle still reaches it
+  // (a slit of one edge between two particles inside the cloth opens nothing).
+  const auto reaches = [&](Vec3 x) {
+    const Real u = ahead(x);
+    return u >= -line.onLine && u <= length + line.onLine;
+  };
   for (std::size_t p = 0; p < n0; ++p) {
     line.place(p, glm::dot(s.position[p] - a, normal));
     // A point of the cut on a particle: one on the line, within the swipe (or where the last segment left off).
-    line.onCut[p] = line.side[p] == 0 && (within(s.position[p]) || line.joins[p]);
+    line.onCut[p] = line.side[p] == 0 && (reaches(s.position[p]) || line.joins[p]);
   }
   line.counts = [&](ParticleIndex p, ParticleIndex q, Real at) {
     return within(glm::mix(s.position[p], s.position[q], at));
