@@ -1308,6 +1308,15 @@ Real largestEigen(const std::array<Real, 6>& m, Vec3 start, Vec3& direction) {
 constexpr int kTearPasses = 8;   // breaking passes a step at most, the cloth relaxed between them
 constexpr int kRelaxSweeps = 4;  // Gauss-Seidel sweeps over the stretch links near a fresh crack
 constexpr int kRelaxRings = 3;   // ... within this many rings of triangles of it
+// A crack's tip: a particle on a border whose triangles span more than this around it (the rest of
+// the turn is the slit).
+constexpr Real kTipAngle = 1.5 * 3.14159265358979323846;
+// The triangles whose stretch sets the way a tip runs: those whose centres lie within this many
+// spacings of it at rest (two rings of triangles, about 1.5 spacings, before; docs/design.md).
+constexpr Real kTipReach = 4.0;
+// No crack starts within this many spacings of a tip: the flanks just behind a running crack's tip
+// are stretched as it opens, and a crack started there is a branch (docs/design.md).
+constexpr Real kStartClear = 8.0;
 
 // Breaks the fan of particle v along the line through it perpendicular to `pull` (rest space): on
 // both sides where v lies inside the cloth, else on the side that runs into the cloth, away from
@@ -1483,6 +1492,41 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     if (!any) break;
     build(cloth);
     const Incidence incidence(rest.triangles, n);
+    // The stretch tensors, averaged by area, of the triangles reached from v through the mesh whose
+    // centres lie within kTipReach spacings of it at rest.
+    std::vector<std::uint8_t> reached(triangles, 0);
+    std::vector<ParticleIndex> front;
+    std::vector<std::uint32_t> seen, within;
+    const auto stressAround = [&](ParticleIndex v) {
+      const Vec3 at = rest.restPosition(v);
+      const Real reach = kTipReach * cloth.topology.spacing;
+      for (const std::uint32_t t : seen) reached[t] = 0;
+      seen.clear();
+      within.clear();
+      front.assign(1, v);
+      while (!front.empty()) {
+        const ParticleIndex q = front.back();
+        front.pop_back();
+        for (auto t = incidence.begin(q); t != incidence.end(q); ++t) {
+          if (reached[*t]) continue;
+          reached[*t] = 1;
+          seen.push_back(*t);
+          const Triangle& c = rest.triangles[*t];
+          const Vec3 centre = (rest.restPosition(c[0]) + rest.restPosition(c[1]) + rest.restPosition(c[2])) / 3.0;
+          if (!(glm::length(centre - at) <= reach)) continue;
+          within.push_back(*t);
+          for (int k = 0; k < 3; ++k) front.push_back(c[k]);
+        }
+      }
+      std::sort(within.begin(), within.end());  // a sum in one order whatever the walk
+      std::array<Real, 6> wide{};
+      for (const std::uint32_t t : within) {
+        const Real a = triangleArea(rest, rest.triangles[t]);
+        const std::array<Real, 6> tensor = tensorOf(t);
+        for (std::size_t k = 0; k < 6; ++k) wide[k] += a * tensor[k];
+      }
+      return wide;
+    };
     // The particles of overstretched triangles, as candidates, the most stretched first.
     std::vector<std::uint8_t> candidate(n, 0);
     for (std::size_t t = 0; t < triangles; ++t) {
@@ -1502,6 +1546,19 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
       }
       return false;
     };
+    // The angle v's triangles span around it at rest (2 pi inside the cloth).
+    const auto fanAngle = [&](ParticleIndex v) {
+      Real angle = 0.0;
+      for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
+        const Triangle& c = rest.triangles[*t];
+        const int cv = cornerOf(c, v);
+        const Vec3 e1 = rest.restPosition(c[(cv + 1) % 3]) - rest.restPosition(v);
+        const Vec3 e2 = rest.restPosition(c[(cv + 2) % 3]) - rest.restPosition(v);
+        if (glm::length(e1) > 0.0 && glm::length(e2) > 0.0)
+          angle += std::acos(std::clamp(glm::dot(glm::normalize(e1), glm::normalize(e2)), -1.0, 1.0));
+      }
+      return angle;
+    };
     struct Break {
       Real stretch;
       ParticleIndex particle;
@@ -1513,7 +1570,7 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
       if (!candidate[p]) continue;
       const auto v = static_cast<ParticleIndex>(p);
       std::array<Real, 6> sum{};
-      Real area = 0.0, most = 0.0, angle = 0.0;
+      Real area = 0.0, most = 0.0;
       Vec3 mostPull{0.0};
       for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
         const Triangle& c = rest.triangles[*t];
@@ -1521,11 +1578,6 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
         const std::array<Real, 6> tensor = tensorOf(*t);
         for (std::size_t k = 0; k < 6; ++k) sum[k] += a * tensor[k];
         area += a;
-        const int cv = cornerOf(c, v);
-        const Vec3 e1 = rest.restPosition(c[(cv + 1) % 3]) - rest.restPosition(v);
-        const Vec3 e2 = rest.restPosition(c[(cv + 2) % 3]) - rest.restPosition(v);
-        if (glm::length(e1) > 0.0 && glm::length(e2) > 0.0)
-          angle += std::acos(std::clamp(glm::dot(glm::normalize(e1), glm::normalize(e2)), -1.0, 1.0));
         if (largest[*t] > most) {
           most = largest[*t];
           largestEigen(tensor, Vec3{1.0, 0.7, 0.3}, mostPull);
@@ -1535,26 +1587,12 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
       for (Real& e : sum) e /= area;
       Vec3 pull;
       const Real value = std::sqrt(std::max(largestEigen(sum, mostPull, pull), 0.0));
-      const bool tip = angle > 1.5 * 3.141592653589793 && onBorder(v);
+      const bool tip = onBorder(v) && fanAngle(v) > kTipAngle;
       if (tip && most > threshold) {
-        // The way a tip runs: across the pull of the triangles within two rings of it, which
-        // smooths out the tip's own field (it turns sharply around a slit's end).
-        std::vector<std::uint32_t> ring;
-        for (auto t = incidence.begin(v); t != incidence.end(v); ++t) {
-          for (int k = 0; k < 3; ++k) {
-            const ParticleIndex q = rest.triangles[*t][k];
-            ring.insert(ring.end(), incidence.begin(q), incidence.end(q));
-          }
-        }
-        std::sort(ring.begin(), ring.end());
-        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-        std::array<Real, 6> wide{};
-        for (const std::uint32_t t : ring) {
-          const Real a = triangleArea(rest, rest.triangles[t]);
-          const std::array<Real, 6> tensor = tensorOf(t);
-          for (std::size_t k = 0; k < 6; ++k) wide[k] += a * tensor[k];
-        }
-        largestEigen(wide, pull, pull);
+        // The way a tip runs: across the pull of the triangles within kTipReach spacings of it,
+        // which smooths out the tip's own field (it turns sharply around a slit's end) and the
+        // lattice's grain.
+        largestEigen(stressAround(v), pull, pull);
         breaks.push_back({most, v, pull, true});
       } else if (!tip && value > threshold) {
         breaks.push_back({value, v, pull, false});
@@ -1574,8 +1612,22 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     // The triangles around each particle as they are now: made again after every break (a break
     // splits triangles and puts new ones at the end).
     std::optional<Incidence> now;
+    // Where the cloth's crack tips are (at rest): no crack starts within kStartClear spacings of one.
+    std::vector<Vec3> tips;
+    for (std::size_t p = 0; p < n; ++p) {
+      const auto v = static_cast<ParticleIndex>(p);
+      if (onBorder(v) && fanAngle(v) > kTipAngle) tips.push_back(rest.restPosition(v));
+    }
+    const auto nearATip = [&](ParticleIndex p) {
+      const Vec3 x = rest.restPosition(p);
+      for (const Vec3& t : tips) {
+        if (glm::length(t - x) < kStartClear * cloth.topology.spacing) return true;
+      }
+      return false;
+    };
     for (const Break& b : breaks) {
       if (near[b.particle] || (!b.tip && started)) continue;
+      if (!b.tip && nearATip(b.particle)) continue;
       if (!now) now.emplace(cloth.rest.triangles, cloth.rest.particleCount());
       if (!breakAt(cloth, b.particle, b.pull, *now, particleBudget, inserted, opening)) continue;
       if (!b.tip) started = true;
