@@ -116,8 +116,14 @@ inline double estimatedParticles(const sim::WorldSettings& world) {
 // that times the square of the ratio to a fifth. (A 24 x 24 sheet torn to shreds in its first step
 // at 2 cm, 0.46 of its 4.3 cm spacing, listed 326 pairs a particle: 0.8 s in Release and 9 s under
 // the sanitizers for that one step; docs/fuzzing.md, Findings.)
+//
+// A pin placed far from where its lattice puts the particle drags the cloth that far in its first
+// step, shredding it on the way (a tear threshold near 1) and sweeping every piece's box across the
+// others: beyond ten spacings from the lattice's reach, that times the distance over ten spacings.
+// (A 24 x 24 sheet 9 m by 2 m built 50 m from its pins, at 2 cm: 1.2 s for two steps in Release
+// and 9.8 s for one in the fuzz build, at 260 sweeps; docs/fuzzing.md, Findings.)
 inline double selfContactSweeps(const sim::WorldSettings& world) {
-  double spacing = HUGE_VAL;
+  double spacing = HUGE_VAL, far = 0.0;
   for (const sim::ClothSettings& cloth : world.cloths) {
     if (cloth.outline) {
       spacing = std::min(spacing, cloth.outline->spacing);
@@ -126,11 +132,20 @@ inline double selfContactSweeps(const sim::WorldSettings& world) {
     const sim::LatticeSpec& grid = cloth.lattice;
     if (grid.columns > 1) spacing = std::min(spacing, grid.width / (grid.columns - 1));
     if (grid.rows > 1) spacing = std::min(spacing, grid.height / (grid.rows - 1));
+    // The lattice lies within width + height of its origin along every axis, whatever its plane.
+    const double reach = std::abs(grid.width) + std::abs(grid.height);
+    for (const sim::Pin& pin : cloth.pins) {
+      if (!pin.position) continue;
+      const glm::dvec3 d = glm::max(glm::abs(*pin.position - grid.origin) - reach, glm::dvec3{0.0});
+      far = std::max(far, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
+    }
   }
   const double ratio = world.selfCollision.distance / (0.2 * spacing);
   // (Not a number, or a spacing of nothing: as many as the cap.)
-  const double factor = ratio <= 1.0 ? 1.0 : std::min(ratio * ratio, 1.0e6);
-  return kSelfContactSweeps * (std::isnan(factor) ? 1.0e6 : factor);
+  double factor = ratio <= 1.0 ? 1.0 : std::min(ratio * ratio, 1.0e6);
+  const double dragged = far / (10.0 * spacing);
+  if (!(dragged <= 1.0)) factor *= std::isnan(dragged) ? 1.0e6 : std::min(dragged, 1.0e6);
+  return kSelfContactSweeps * (std::isnan(factor) ? 1.0e6 : std::min(factor, 1.0e6));
 }
 
 // How many of `wanted` steps fit the budget for a world of `particles` particles.
