@@ -378,6 +378,10 @@ constexpr Real kMergeChord = 0.2;
 constexpr int kMergeAttempts = 4;
 // A child a shared particle makes needs at least this many spacings squared of doubled area.
 constexpr Real kLeastMergedArea = 2e-2;
+// Nor may the move leave one of its triangles with an angle under this (radians), smaller than it
+// was: among the small triangles many crossing cuts leave, a particle moved onto the line could
+// flatten a triangle whose other corners lie on it too (0.8 degrees after a tear there).
+constexpr Real kSnapLeastAngle = 10.0 * 3.14159265358979323846 / 180.0;
 // A triangle a particle moved onto the line leaves needs at least this many.
 constexpr Real kLeastChildArea = 1e-3;
 
@@ -386,8 +390,7 @@ Real restEdge(const ClothRest& rest, ParticleIndex a, ParticleIndex b) {
 }
 
 // The smallest angle of a triangle at rest, in radians (0 for a degenerate one).
-Real smallestAngle(const ClothRest& rest, ParticleIndex a, ParticleIndex b, ParticleIndex c) {
-  const Vec3 p[3] = {rest.restPosition(a), rest.restPosition(b), rest.restPosition(c)};
+Real smallestAngleOf(const Vec3 (&p)[3]) {
   Real least = 3.2;
   for (int k = 0; k < 3; ++k) {
     const Vec3 u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
@@ -396,6 +399,10 @@ Real smallestAngle(const ClothRest& rest, ParticleIndex a, ParticleIndex b, Part
     least = std::min(least, std::acos(std::clamp(glm::dot(u, v) / (lu * lv), -1.0, 1.0)));
   }
   return least;
+}
+Real smallestAngle(const ClothRest& rest, ParticleIndex a, ParticleIndex b, ParticleIndex c) {
+  const Vec3 p[3] = {rest.restPosition(a), rest.restPosition(b), rest.restPosition(c)};
+  return smallestAngleOf(p);
 }
 
 // A new particle at a + s (b - a), at rest and now; its mass is set later (cutMasses).
@@ -549,6 +556,8 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
       if (!(glm::dot(glm::cross(r[1] - r[0], r[2] - r[0]), restFacing) > least) ||
           !(glm::dot(glm::cross(y[1] - y[0], y[2] - y[0]), nowFacing) > 0.0))
         fair = false;
+      const Real after = smallestAngleOf(r);
+      if (after < kSnapLeastAngle && after < smallestAngle(rest, c[0], c[1], c[2])) fair = false;
     }
     if (!fair) continue;
     rest.restOffsets[p] = offset;
