@@ -1321,8 +1321,9 @@ constexpr int kRelaxRings = 3;   // ... within this many rings of triangles of i
 // the turn is the slit).
 constexpr Real kTipAngle = 1.5 * 3.14159265358979323846;
 // The triangles whose stretch sets the way a tip runs: those whose centres lie within this many
-// spacings of it at rest (two rings of triangles, about 1.5 spacings, before; docs/design.md).
-constexpr Real kTipReach = 4.0;
+// spacings of it at rest (two rings of triangles, about 1.5 spacings, before; 4 and 6 measured
+// worse; docs/design.md).
+constexpr Real kTipReach = 5.0;
 // No crack starts within this many spacings of a tip: the flanks just behind a running crack's tip
 // are stretched as it opens, and a crack started there is a branch (docs/design.md).
 constexpr Real kStartClear = 8.0;
