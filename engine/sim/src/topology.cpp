@@ -389,7 +389,8 @@ Real restEdge(const ClothRest& rest, ParticleIndex a, ParticleIndex b) {
   return glm::length(rest.restPosition(b) - rest.restPosition(a));
 }
 
-// The smallest angle of a triangle at rest, in radians (0 for a degenerate one).
+// The smallest angle of a triangle with these corners, in radians (0 for a degenerate one); and of
+// a triangle of particles at rest.
 Real smallestAngleOf(const Vec3 (&p)[3]) {
   Real least = 3.2;
   for (int k = 0; k < 3; ++k) {
@@ -1321,8 +1322,8 @@ constexpr int kRelaxRings = 3;   // ... within this many rings of triangles of i
 // the turn is the slit).
 constexpr Real kTipAngle = 1.5 * 3.14159265358979323846;
 // The triangles whose stretch sets the way a tip runs: those whose centres lie within this many
-// spacings of it at rest (two rings of triangles, about 1.5 spacings, before; 4 and 6 measured
-// worse; docs/design.md).
+// spacings of it at rest (two rings of triangles, about 1.5 spacings, before; 4 straightened
+// cracks less, 6 more but at a cost elsewhere; docs/design.md).
 constexpr Real kTipReach = 5.0;
 // No crack starts within this many spacings of a tip: the flanks just behind a running crack's tip
 // are stretched as it opens, and a crack started there is a branch (docs/design.md).
@@ -1622,11 +1623,15 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     // The triangles around each particle as they are now: made again after every break (a break
     // splits triangles and puts new ones at the end).
     std::optional<Incidence> now;
-    // Where the cloth's crack tips are (at rest): no crack starts within kStartClear spacings of one.
+    // Where the cloth's crack tips are (at rest), on the mesh as the pass found it: no crack starts
+    // within kStartClear spacings of one. Wanted only where one might start (the first pass, and a
+    // particle away from tips over the threshold).
     std::vector<Vec3> tips;
-    for (std::size_t p = 0; p < n; ++p) {
-      const auto v = static_cast<ParticleIndex>(p);
-      if (onBorder(v) && fanAngle(v) > kTipAngle) tips.push_back(rest.restPosition(v));
+    if (!started && std::any_of(breaks.begin(), breaks.end(), [](const Break& b) { return !b.tip; })) {
+      for (std::size_t p = 0; p < n; ++p) {
+        const auto v = static_cast<ParticleIndex>(p);
+        if (onBorder(v) && fanAngle(v) > kTipAngle) tips.push_back(rest.restPosition(v));
+      }
     }
     const auto nearATip = [&](ParticleIndex p) {
       const Vec3 x = rest.restPosition(p);
