@@ -494,6 +494,15 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
     return static_cast<std::uint64_t>(std::min(p, q)) << 32 | std::max(p, q);
   };
   const auto crosses = [&](ParticleIndex p, ParticleIndex q) { return side[p] * side[q] < 0; };
+  // The side of the plane a triangle's third corner lies on, beside an edge on the cut: its side,
+  // or for a particle within kOnLine spacings, the sign of its distance. A thin triangle along the
+  // line (as earlier cuts and a crack's flanks leave) has all three corners within them; taking
+  // them all as on the line left its edge on the cut joined, and the cloth joined across the cut
+  // (and a crack's tip held still there).
+  const auto sideOf = [&](ParticleIndex p) -> int {
+    if (side[p] != 0) return side[p];
+    return distance[p] > 0.0 ? 1 : distance[p] < 0.0 ? -1 : 0;
+  };
   const auto crossingAt = [&](ParticleIndex p, ParticleIndex q) { return distance[p] / (distance[p] - distance[q]); };
   // New particles where the plane crosses an edge, one per edge.
   std::vector<std::pair<std::uint64_t, ParticleIndex>> crossing;  // edge key -> its particle
@@ -674,7 +683,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
       }
       if (count == 0) {
         for (int k = 0; k < 3; ++k) {
-          if (onCut(c[k]) && onCut(c[(k + 1) % 3]) && side[c[(k + 2) % 3]] != 0) onEdge.push_back({t, k});
+          if (onCut(c[k]) && onCut(c[(k + 1) % 3]) && sideOf(c[(k + 2) % 3]) != 0) onEdge.push_back({t, k});
         }
         continue;
       }
@@ -895,7 +904,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
     for (int k = 0; k < 3; ++k) {
       if (o[k] != p && o[k] != q) far = o[k];
     }
-    if (side[t[(e.edge + 2) % 3]] * side[far] >= 0) continue;
+    if (sideOf(t[(e.edge + 2) % 3]) * sideOf(far) >= 0) continue;
     opening.touched.push_back(p);
     opening.touched.push_back(q);
     sever(topology, e.triangle, e.edge);
