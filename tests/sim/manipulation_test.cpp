@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <numeric>
+#include <optional>
 
 #include <glm/geometric.hpp>
 
@@ -595,8 +597,10 @@ TEST(Cutting, EverySwipeAcrossTheSheetPartsWhatLiesOnEitherSideOfIt) {
 
 // A 32 x 32 sheet with a notch across `pull` at its centre (moved `offset` spacings along x), every
 // border particle held by a finger and moved so the sheet stretches along `pull` (uniaxially, 50 %
-// a second) for `steps` steps, or (untilInTwo) until it is in two pieces.
-World stretchedWithANotch(Vec3 pull, int steps, Real offset = 0.0, bool untilInTwo = false) {
+// a second) for `steps` steps, or (untilInTwo) until it is in two pieces; cut first along `slit`
+// too, where given.
+World stretchedWithANotch(Vec3 pull, int steps, Real offset = 0.0, bool untilInTwo = false,
+                          std::optional<std::pair<Vec3, Vec3>> slit = std::nullopt) {
   const int n = 32;
   const Real h = 1.0 / (n - 1);
   WorldSettings settings = flatSheet(n);
@@ -604,6 +608,7 @@ World stretchedWithANotch(Vec3 pull, int steps, Real offset = 0.0, bool untilInT
   World world(settings);
   const Vec3 centre{0.5 + offset * h, 0.0, 0.5}, across{-pull.z, 0.0, pull.x};
   world.cut(centre - 2.1 * h * across, centre + 2.1 * h * across, Vec3{0.0, -1.0, 0.0});
+  if (slit) world.cut(slit->first, slit->second, Vec3{0.0, -1.0, 0.0});
   const Cloth& cloth = world.cloths()[0];
   std::vector<Vec3> start;
   for (int row = 0; row < n; ++row) {
@@ -713,6 +718,38 @@ TEST(Tearing, NotchedSheetsPulledEveryFifteenDegreesTearAcrossThePullAndNearlySt
   }
   EXPECT_GE(near, 20);
   EXPECT_LT(sum / sheets, 0.4);
+}
+
+TEST(Tearing, ACrackThatRunsIntoAClosedSlitSplitsBothItsFlanksWhereItMeetsThem) {
+  // A notched sheet pulled along x, with a slit along x 8.3 spacings above the notch: pulled along
+  // its own line, the slit stays closed (its two flanks on each other), and the crack from the
+  // notch runs across the pull into it. Where it meets the slit it splits the border edge of the
+  // flank it comes from; the other flank's edge there is split at the same point too, so every
+  // point of the slit at rest still has a particle on each flank (before, the new corner was on
+  // the crack's flank only: it lay on the other flank's edge, a T-junction where the two touch).
+  const Real h = 1.0 / 31.0;
+  const Real z = 0.5 + 8.3 * h;
+  const Vec3 from{0.5 - 6.2 * h, 0.0, z}, to{0.5 + 6.2 * h, 0.0, z};
+  const auto onSlit = [&](Vec3 r) { return std::abs(r.z - z) < 1e-6 && r.x > from.x + 1e-6 && r.x < to.x - 1e-6; };
+  // Per point of the slit at rest, the flanks with a particle there: 1 below it, 2 above (where
+  // the particle's triangles lie).
+  const auto flanks = [&](const Cloth& cloth) {
+    std::map<std::pair<float, float>, int> at;
+    for (const glm::uvec3& t : cloth.rest.triangles) {
+      const Real centre =
+          (cloth.rest.restPosition(t[0]).z + cloth.rest.restPosition(t[1]).z + cloth.rest.restPosition(t[2]).z) / 3.0;
+      for (int k = 0; k < 3; ++k) {
+        if (!onSlit(cloth.rest.restPosition(t[k]))) continue;
+        at[{cloth.rest.restOffsets[t[k]].x, cloth.rest.restOffsets[t[k]].z}] |= centre < z ? 1 : 2;
+      }
+    }
+    return at;
+  };
+  const auto before = flanks(stretchedWithANotch(Vec3{1.0, 0.0, 0.0}, 0, 0.0, false, std::pair{from, to}).cloths()[0]);
+  const World world = stretchedWithANotch(Vec3{1.0, 0.0, 0.0}, 30, 0.0, false, std::pair{from, to});
+  const auto after = flanks(world.cloths()[0]);
+  EXPECT_GT(after.size(), before.size()) << "the crack did not reach the slit";
+  for (const auto& [at, which] : after) EXPECT_EQ(which, 3) << "at x = " << at.first;
 }
 
 TEST(Tearing, AFastPullTearsAWideSheetInTwoBetweenItsGrips) {
