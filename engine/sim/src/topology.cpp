@@ -506,13 +506,13 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
   const auto crossingAt = [&](ParticleIndex p, ParticleIndex q) { return distance[p] / (distance[p] - distance[q]); };
   // New particles where the plane crosses an edge, one per edge.
   std::vector<std::pair<std::uint64_t, ParticleIndex>> crossing;       // edge key -> its particle
-  std::vector<std::pair<ParticleIndex, ParticleIndex>> borderCrossed;  // crossed edges on a border
+  std::vector<std::pair<ParticleIndex, ParticleIndex>> borderCrossed;  // of `consider`: crossed border edges
   const auto look = [&](std::uint32_t t) {
     for (int k = 0; k < 3; ++k) {
       const ParticleIndex p = rest.triangles[t][k], q = rest.triangles[t][(k + 1) % 3];
       if (!crosses(p, q) || !line.counts(p, q, crossingAt(p, q))) continue;
       crossing.push_back({key(p, q), 0});
-      if (topology.neighbour[t][static_cast<std::size_t>(k)] < 0) borderCrossed.push_back({p, q});
+      if (consider && topology.neighbour[t][static_cast<std::size_t>(k)] < 0) borderCrossed.push_back({p, q});
     }
   };
   if (consider) {
@@ -527,20 +527,18 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
   // corner of this flank lies on the other flank's edge, a T-junction where the two touch, and
   // the flanks no longer have matching corners to close on. (An opening of every triangle, a cut,
   // crosses both edges anyway.)
-  if (consider) {
-    for (const auto& [p, q] : borderCrossed) {
-      for (std::size_t a = 0; a < n0; ++a) {
-        if (a == p || rest.restOffsets[a] != rest.restOffsets[p]) continue;
-        const auto twin = static_cast<ParticleIndex>(a);
-        for (auto t = incidence.begin(twin); t != incidence.end(twin); ++t) {
-          const Triangle& c = rest.triangles[*t];
-          for (int k = 0; k < 3; ++k) {
-            const ParticleIndex u = c[k], w = c[(k + 1) % 3];
-            if (topology.neighbour[*t][static_cast<std::size_t>(k)] >= 0 || (u != twin && w != twin)) continue;
-            const ParticleIndex other = u == twin ? w : u;
-            if (rest.restOffsets[other] != rest.restOffsets[q]) continue;  // q itself where the seam ends there
-            if (crosses(u, w) && line.counts(u, w, crossingAt(u, w))) crossing.push_back({key(u, w), 0});
-          }
+  for (const auto& [p, q] : borderCrossed) {
+    for (std::size_t a = 0; a < n0; ++a) {
+      if (a == p || rest.restOffsets[a] != rest.restOffsets[p]) continue;
+      const auto twin = static_cast<ParticleIndex>(a);
+      for (auto t = incidence.begin(twin); t != incidence.end(twin); ++t) {
+        const Triangle& c = rest.triangles[*t];
+        for (int k = 0; k < 3; ++k) {
+          const ParticleIndex u = c[k], w = c[(k + 1) % 3];
+          if (topology.neighbour[*t][static_cast<std::size_t>(k)] >= 0 || (u != twin && w != twin)) continue;
+          const ParticleIndex other = u == twin ? w : u;
+          if (rest.restOffsets[other] != rest.restOffsets[q]) continue;  // q itself where the seam ends there
+          if (crosses(u, w) && line.counts(u, w, crossingAt(u, w))) crossing.push_back({key(u, w), 0});
         }
       }
     }
