@@ -13,6 +13,7 @@
 #include <glm/common.hpp>
 #include <nlohmann/json.hpp>
 
+#include "drape/mesh/outline.hpp"
 #include "drape/sim/settings.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
@@ -54,7 +55,7 @@ inline std::string_view text(const std::uint8_t* data, std::size_t size) {
 // L^2 / (4 pi) (and at most the stroke's bounding box); a particle per lattice cell of that area
 // plus a few per spacing of the border. Measured in spacings, so that a tiny spacing does not
 // underflow. Infinite when that is not a finite number (the engine must refuse those at once).
-inline double estimatedParticles(const sim::OutlineSpec& outline) {
+inline double estimatedParticles(const mesh::OutlineSpec& outline) {
   if (outline.points.empty()) return 0.0;
   const double s = outline.spacing;
   glm::dvec2 lower = outline.points.front() / s, upper = lower;
@@ -72,9 +73,9 @@ inline double estimatedParticles(const sim::OutlineSpec& outline) {
   return std::isfinite(estimate) ? estimate : HUGE_VAL;
 }
 
-// Particles a cloth will have, before it is built.
+// Particles a cloth will have, before it is built (a drawn cloth's mesh is made when its scene is read).
 inline double estimatedParticles(const sim::ClothSettings& cloth) {
-  if (cloth.outline) return estimatedParticles(*cloth.outline);
+  if (cloth.mesh) return static_cast<double>(cloth.mesh->positions.size());
   return static_cast<double>(cloth.lattice.columns) * static_cast<double>(cloth.lattice.rows);
 }
 
@@ -87,7 +88,7 @@ inline double estimatedOutlineParticles(const nlohmann::json& scene) {
   for (const nlohmann::json& cloth : scene["cloths"]) {
     if (!cloth.is_object() || !cloth.contains("outline") || !cloth["outline"].is_object()) continue;
     const nlohmann::json& outline = cloth["outline"];
-    sim::OutlineSpec spec;
+    mesh::OutlineSpec spec;
     if (outline.contains("spacing") && outline["spacing"].is_number()) spec.spacing = outline["spacing"].get<double>();
     // What the reader refuses before it builds (docs/scenes.md's ranges), it refuses at once.
     if (!(spec.spacing >= 1.0e-3 && spec.spacing <= 10.0)) continue;
@@ -125,8 +126,8 @@ inline double estimatedParticles(const sim::WorldSettings& world) {
 inline double selfContactSweeps(const sim::WorldSettings& world) {
   double spacing = HUGE_VAL, far = 0.0;
   for (const sim::ClothSettings& cloth : world.cloths) {
-    if (cloth.outline) {
-      spacing = std::min(spacing, cloth.outline->spacing);
+    if (cloth.mesh) {
+      spacing = std::min(spacing, cloth.mesh->spacing);
       continue;
     }
     const sim::LatticeSpec& grid = cloth.lattice;

@@ -1,4 +1,5 @@
-// Fuzzes the outline builder (a cloth cut to a drawn stroke, sim::buildFromOutline).
+// Fuzzes the outline mesher (a cloth cut to a drawn stroke: mesh::meshOutline, then the engine's
+// sim::constrainMesh).
 //
 // The bytes are read as an OutlineSpec, so that both wild and plausible strokes come up:
 //   byte 0: bit 0: spacing and height are raw doubles; bit 1: points are raw doubles; bit 2:
@@ -11,16 +12,21 @@
 // A stroke that could fill more than 400 particles (fuzz_support.hpp) is skipped (slow, not
 // hostile), unless its numbers are not finite, which the builder must refuse at once.
 //
-// Checked of a cloth it builds: every index names a particle it has, every position and rest
-// length is finite, there is a loop of at least 3 corners, and (for small cloths) building it
-// again gives the same cloth. Expected failure: std::invalid_argument; anything else escapes, and
-// libFuzzer reports it.
+// Checked of a mesh it makes: every index names a particle it has, every position is finite, no
+// two particles stand for one lattice node, there is a loop of at least 3 corners, and (for small
+// cloths) meshing it again gives the same mesh; the engine takes it (constrainMesh refusing it is
+// a failure), and every constraint it makes names two particles and has a finite rest length.
+// Expected failure: std::invalid_argument from the mesher; anything else escapes, and libFuzzer
+// reports it.
 #include <cmath>
 #include <cstring>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
-#include "drape/sim/outline.hpp"
+#include "drape/mesh/outline.hpp"
+#include "drape/sim/cloth.hpp"
 #include "fuzz_support.hpp"
 
 using namespace drape;
@@ -36,28 +42,37 @@ T take(const std::uint8_t*& data, std::size_t& size) {
   return value;
 }
 
-void check(const sim::OutlineCloth& cloth) {
-  const sim::ClothRest& rest = cloth.rest;
-  const std::size_t n = rest.particleCount();
-  if (n < 3 || rest.triangles.empty()) fuzz::broken("an outline cloth without particles or triangles");
-  if (cloth.loop.size() < 3) fuzz::broken("an outline cloth's loop has fewer than 3 corners");
-  if (rest.columns != 0 || rest.rows != 0) fuzz::broken("an outline cloth claims to be a lattice");
-  for (std::size_t i = 0; i < n; ++i) {
-    const sim::Vec3 p = rest.restPosition(i);
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) fuzz::broken("a rest position not finite");
+void check(const mesh::OutlineMesh& shape) {
+  const std::size_t n = shape.positions.size();
+  if (n < 3 || shape.triangles.empty()) fuzz::broken("an outline mesh without particles or triangles");
+  if (shape.nodes.size() != n) fuzz::broken("an outline mesh without a node (or none) for every particle");
+  if (shape.loop.size() < 3) fuzz::broken("an outline mesh's loop has fewer than 3 corners");
+  for (const glm::dvec3& p : shape.positions) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) fuzz::broken("a position not finite");
   }
-  for (const glm::uvec3& t : rest.triangles) {
-    if (t.x >= n || t.y >= n || t.z >= n) fuzz::broken("a triangle names a particle the cloth does not have");
+  for (const glm::uvec3& t : shape.triangles) {
+    if (t.x >= n || t.y >= n || t.z >= n) fuzz::broken("a triangle names a particle the mesh does not have");
     if (t.x == t.y || t.y == t.z || t.x == t.z) fuzz::broken("a triangle names one particle twice");
   }
+  std::set<std::pair<int, int>> nodes;
+  for (const glm::ivec2& node : shape.nodes) {
+    if (node == mesh::kNoNode) continue;
+    if (node.x < 0 || node.y < 0) fuzz::broken("a lattice node with a negative column or row");
+    if (!nodes.insert({node.x, node.y}).second) fuzz::broken("two particles stand for one lattice node");
+  }
+  for (const glm::dvec2& p : shape.loop) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) fuzz::broken("a loop point not finite");
+  }
+}
+
+void check(const sim::ClothRest& rest) {
+  const std::size_t n = rest.particleCount();
+  if (rest.columns != 0 || rest.rows != 0) fuzz::broken("an outline cloth claims to be a lattice");
   for (sim::ConstraintKind kind : sim::kConstraintKinds) {
     for (const sim::DistanceConstraint& k : rest.of(kind)) {
       if (k.a >= n || k.b >= n || k.a == k.b) fuzz::broken("a constraint names a wrong particle");
       if (!std::isfinite(k.restLength) || k.restLength < 0) fuzz::broken("a rest length not finite");
     }
-  }
-  for (const glm::dvec2& p : cloth.loop) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y)) fuzz::broken("a loop point not finite");
   }
 }
 
@@ -68,7 +83,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto flags = take<std::uint8_t>(data, size);
   const bool rawHeader = flags & 1, rawPoints = flags & 2, wide = flags & 4;
   const int e = flags >> 3;
-  sim::OutlineSpec spec;
+  mesh::OutlineSpec spec;
   std::uint8_t kinds = 0;
   if (rawHeader) {
     if (size < 17) return 0;
@@ -102,17 +117,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   const double particles = fuzz::estimatedParticles(spec);
   if (std::isfinite(particles) && particles > fuzz::kMaxOutlineParticles) return 0;
+  mesh::OutlineMesh shape;
   try {
-    const sim::OutlineCloth cloth = sim::buildFromOutline(spec, selection);
-    check(cloth);
-    if (cloth.rest.particleCount() <= 500) {
-      const sim::OutlineCloth again = sim::buildFromOutline(spec, selection);
-      if (again.rest.restOffsets != cloth.rest.restOffsets || again.rest.triangles != cloth.rest.triangles ||
-          again.loop != cloth.loop || again.tookLargestLoop != cloth.tookLargestLoop) {
-        fuzz::broken("the same outline built twice gives two cloths");
-      }
-    }
+    shape = mesh::meshOutline(spec);
   } catch (const std::invalid_argument&) {
+    return 0;
+  }
+  check(shape);
+  if (shape.positions.size() <= 500) {
+    const mesh::OutlineMesh again = mesh::meshOutline(spec);
+    if (again.positions != shape.positions || again.triangles != shape.triangles || again.nodes != shape.nodes ||
+        again.loop != shape.loop || again.tookLargestLoop != shape.tookLargestLoop) {
+      fuzz::broken("the same outline meshed twice gives two meshes");
+    }
+  }
+  try {
+    check(sim::constrainMesh({shape.positions, shape.triangles, shape.nodes, spec.spacing}, selection));
+  } catch (const std::invalid_argument& error) {
+    fuzz::broken((std::string("the engine refused the mesher's mesh: ") + error.what()).c_str());
   }
   return 0;
 }

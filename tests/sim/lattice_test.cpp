@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -20,6 +22,96 @@ TEST(Lattice, ConstraintCountsFollowTheSeedsLattice) {
   EXPECT_EQ(rest.of(ConstraintKind::shear).size(), 2u * 4 * 3);         // both diagonals of every cell
   EXPECT_EQ(rest.of(ConstraintKind::bend).size(), 3u * 4 + 5u * 2);     // neighbours two apart
   EXPECT_EQ(rest.triangles.size(), 2u * 4 * 3);
+}
+
+// The seed's lattice, constraint by constraint in the order the solver sweeps them (Gauss-Seidel:
+// the order is part of the result), written out as the seed walks it: per particle, row by row, its
+// neighbour along the row, then down the column; per cell, its diagonal from (column, row), then the
+// other; per particle, two along the row, then two down.
+TEST(Lattice, ConstraintsComeInTheSeedsOrderInEitherPlane) {
+  for (const LatticePlane plane : {LatticePlane::xz, LatticePlane::xy}) {
+    const int columns = 5, rows = 4;
+    const ClothRest rest = buildLattice({columns, rows, 1.0, 0.75, Vec3{0.0}, plane});
+    std::array<std::vector<std::pair<ParticleIndex, ParticleIndex>>, kConstraintKindCount> expected;
+    const auto at = [&](int column, int row) { return static_cast<ParticleIndex>(row * columns + column); };
+    for (int row = 0; row < rows; ++row) {
+      for (int column = 0; column < columns; ++column) {
+        if (column + 1 < columns) expected[0].push_back({at(column, row), at(column + 1, row)});
+        if (row + 1 < rows) expected[0].push_back({at(column, row), at(column, row + 1)});
+        if (column + 1 < columns && row + 1 < rows) {
+          expected[1].push_back({at(column, row), at(column + 1, row + 1)});
+          expected[1].push_back({at(column + 1, row), at(column, row + 1)});
+        }
+        if (column + 2 < columns) expected[2].push_back({at(column, row), at(column + 2, row)});
+        if (row + 2 < rows) expected[2].push_back({at(column, row), at(column, row + 2)});
+      }
+    }
+    for (const ConstraintKind kind : kConstraintKinds) {
+      std::vector<std::pair<ParticleIndex, ParticleIndex>> made;
+      for (const DistanceConstraint& c : rest.of(kind)) made.push_back({c.a, c.b});
+      EXPECT_EQ(made, expected[static_cast<std::size_t>(kind)]) << name(kind) << " in " << name(plane);
+    }
+  }
+}
+
+// constrainMesh's rules where a mesh is not a whole lattice: a cell with one triangle gets only the
+// diagonal that triangle has; a particle off the lattice is joined by stretch along its edges; a
+// bend needs both stretch edges through its middle.
+TEST(ConstrainMesh, APartCellGetsOnlyItsOwnDiagonalAndAnOffLatticeCornerStretch) {
+  // Particles 0-4 stand for nodes (0,0) (1,0) (0,1) (1,1) (2,0); 5 stands for none. The cell (0,0)
+  // is whole (two triangles split along (1,0)-(0,1)); the cell (1,0) has one triangle, (1,0) (1,1)
+  // (2,0), whose diagonal is (1,1)-(2,0); a last triangle reaches particle 5.
+  LatticeMesh mesh;
+  mesh.spacing = 1.0;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {1, 0, 1}, {2, 0, 0}, {2.5, 0, 0.5}};
+  mesh.nodes = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0}, kNoNode};
+  mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {1, 3, 4}, {4, 3, 5}};
+  const ClothRest rest = constrainMesh(mesh);
+  const auto pairs = [&](ConstraintKind kind) {
+    std::vector<std::pair<ParticleIndex, ParticleIndex>> made;
+    for (const DistanceConstraint& c : rest.of(kind)) made.push_back({c.a, c.b});
+    return made;
+  };
+  using Pairs = std::vector<std::pair<ParticleIndex, ParticleIndex>>;
+  // Every triangle edge but the diagonals, by particle pair; (3, 5) and (4, 5) reach the particle off the lattice.
+  EXPECT_EQ(pairs(ConstraintKind::stretch), (Pairs{{0, 1}, {0, 2}, {1, 3}, {1, 4}, {2, 3}, {3, 5}, {4, 5}}));
+  // Cell (0,0): its own diagonal (1,2) and, being whole, (0,3) first; cell (1,0): only (4,3), its triangle's.
+  EXPECT_EQ(pairs(ConstraintKind::shear), (Pairs{{0, 3}, {1, 2}, {4, 3}}));
+  // (0,0)-(2,0) through (1,0): both stretch edges there. Nothing down a column (no third row).
+  EXPECT_EQ(pairs(ConstraintKind::bend), (Pairs{{0, 4}}));
+  // Rest lengths from the positions.
+  for (const ConstraintKind kind : kConstraintKinds) {
+    for (const DistanceConstraint& c : rest.of(kind)) {
+      EXPECT_FLOAT_EQ(c.restLength, static_cast<float>(glm::length(mesh.positions[c.b] - mesh.positions[c.a])));
+    }
+  }
+}
+
+TEST(ConstrainMesh, RefusesWhatIsNotAMesh) {
+  LatticeMesh mesh;
+  mesh.spacing = 1.0;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}};
+  mesh.nodes = {{0, 0}, {1, 0}, {0, 1}};
+  mesh.triangles = {{0, 2, 1}};
+  EXPECT_NO_THROW(constrainMesh(mesh));
+  LatticeMesh bad = mesh;
+  bad.nodes.pop_back();
+  EXPECT_THROW(constrainMesh(bad), std::invalid_argument);  // a node (or none) per particle
+  bad = mesh;
+  bad.nodes[2] = {1, 0};
+  EXPECT_THROW(constrainMesh(bad), std::invalid_argument);  // one node stood for twice
+  bad = mesh;
+  bad.nodes[2] = {-3, 0};
+  EXPECT_THROW(constrainMesh(bad), std::invalid_argument);  // off the lattice's quarter
+  bad = mesh;
+  bad.triangles[0] = {0, 2, 3};
+  EXPECT_THROW(constrainMesh(bad), std::invalid_argument);  // a corner out of range
+  bad = mesh;
+  bad.triangles[0] = {0, 2, 2};
+  EXPECT_THROW(constrainMesh(bad), std::invalid_argument);  // a corner twice
+  bad = mesh;
+  bad.positions[1].x = std::nan("");
+  EXPECT_THROW(constrainMesh(bad), std::invalid_argument);
 }
 
 TEST(Lattice, RestLengthsAreTheSpacing) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 
 #include "batches.hpp"
 #include "distance_wide.hpp"
+#include "drape/mesh/outline.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 #include "lines.hpp"
@@ -80,7 +82,10 @@ TEST(Lines, TheStretchConstraintsAreKeptInLineOrderWhateverOrderTheyCameIn) {
   // on the order links are taken in, so build takes them in their particles' order: built again
   // from any order (a snapshot's, or after the threads change), the lines come out the same.
   WorldSettings settings = test::hangingSheet(4, 1, 1);
-  settings.cloths[0].outline = OutlineSpec{{{0.0, 0.0}, {0.9, 0.1}, {0.7, 0.8}, {0.2, 0.6}, {0.4, 0.35}}, 0.07, 1.0};
+  mesh::OutlineMesh shape =
+      mesh::meshOutline({{{0.0, 0.0}, {0.9, 0.1}, {0.7, 0.8}, {0.2, 0.6}, {0.4, 0.35}}, 0.07, 1.0});
+  settings.cloths[0].mesh = std::make_shared<const LatticeMesh>(
+      LatticeMesh{std::move(shape.positions), std::move(shape.triangles), std::move(shape.nodes), 0.07});
   settings.cloths[0].pins.clear();
   World world(settings);
   Cloth cloth = world.cloths()[0];

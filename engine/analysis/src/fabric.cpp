@@ -4,18 +4,27 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <numbers>
 #include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
 
+#include "drape/mesh/outline.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
 
 namespace drape::analysis {
 
 namespace {
+
+// A drawn cloth's mesh: the outline meshed once, for the engine to constrain.
+std::shared_ptr<const sim::LatticeMesh> drawnMesh(const mesh::OutlineSpec& outline) {
+  mesh::OutlineMesh shape = mesh::meshOutline(outline);
+  return std::make_shared<const sim::LatticeMesh>(sim::LatticeMesh{
+      std::move(shape.positions), std::move(shape.triangles), std::move(shape.nodes), outline.spacing});
+}
 
 struct Shot {
   double endSlope;  // theta'(lambda)
@@ -167,7 +176,7 @@ CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::
   const auto at = [&](double a, double b) { return origin + along * a + across * b; };
   sim::WorldSettings settings = labWorld(spec);
   sim::ClothSettings cloth;
-  sim::OutlineSpec outline;
+  mesh::OutlineSpec outline;
   outline.spacing = spec.spacing;
   outline.height = kHeight;
   const double back = -3.0 * spec.spacing;
@@ -176,7 +185,7 @@ CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::
     const sim::Vec3 corner = at(a, b);
     outline.points.push_back({corner.x, corner.z});
   }
-  cloth.outline = outline;
+  cloth.mesh = drawnMesh(outline);
   cloth.fabric = spec.fabric;
   settings.cloths.push_back(cloth);
   sim::World world(settings);
@@ -302,7 +311,7 @@ CusickResult cusick(const CusickSpec& spec) {
   constexpr int kCorners = 180;
   sim::WorldSettings settings = labWorld(spec);
   sim::ClothSettings cloth;
-  sim::OutlineSpec outline;
+  mesh::OutlineSpec outline;
   outline.spacing = spec.spacing;
   outline.height = kHeight;
   const double R = 0.5 * spec.diameter, r = 0.5 * spec.support;
@@ -310,7 +319,7 @@ CusickResult cusick(const CusickSpec& spec) {
     const double t = 2.0 * std::numbers::pi * k / kCorners;
     outline.points.push_back({R * std::cos(t), R * std::sin(t)});
   }
-  cloth.outline = outline;
+  cloth.mesh = drawnMesh(outline);
   cloth.fabric = spec.fabric;
   settings.cloths.push_back(cloth);
   sim::World world(settings);

@@ -7,7 +7,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "drape/sim/outline.hpp"
+#include "drape/mesh/outline.hpp"
 
 namespace drape::interact {
 
@@ -318,14 +318,16 @@ void Interaction::update(Real dt) {
 }
 
 bool Interaction::spawn(const Touch& touch) {
-  sim::OutlineSpec outline;
+  mesh::OutlineSpec outline;
   for (const Vec3& p : touch.stroke) outline.points.push_back({p.x, p.z});
   outline.spacing = settings_.spacing;
   outline.height = settings_.tableHeight + settings_.clothHeight;
   try {
-    const sim::OutlineCloth shape = sim::buildFromOutline(outline);
+    mesh::OutlineMesh shape = mesh::meshOutline(outline);
+    const std::size_t particles = shape.positions.size();
     sim::ClothSettings cloth = settings_.material;
-    cloth.outline = outline;
+    cloth.mesh = std::make_shared<const sim::LatticeMesh>(sim::LatticeMesh{
+        std::move(shape.positions), std::move(shape.triangles), std::move(shape.nodes), outline.spacing});
     cloth.pins.clear();
     cloth.mass = settings_.arealDensity * loopArea(shape.loop);
     spawnedIndex_.push_back(world_.addCloth(cloth));
@@ -337,8 +339,8 @@ bool Interaction::spawn(const Touch& touch) {
         upper = glm::max(upper, p);
       }
       char said[160];
-      std::snprintf(said, sizeof said, "a cloth of %zu particles, %.2f m x %.2f m%s", shape.rest.particleCount(),
-                    upper.x - lower.x, upper.y - lower.y,
+      std::snprintf(said, sizeof said, "a cloth of %zu particles, %.2f m x %.2f m%s", particles, upper.x - lower.x,
+                    upper.y - lower.y,
                     shape.tookLargestLoop ? " (the outline crossed itself: the largest loop was kept)" : "");
       tell(said);
     }

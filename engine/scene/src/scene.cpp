@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colliders.hpp"
+#include "drape/mesh/outline.hpp"
 #include "drape/scene/error.hpp"
 #include "drape/sim/world.hpp"
 #include "json_reader.hpp"
@@ -134,8 +136,8 @@ std::pair<int, int> readParticle(ObjectReader& reader, const sim::LatticeSpec& l
 }
 
 // A drawn cloth: {"points": [[x, z], ...], "spacing": s, "height": y}.
-sim::OutlineSpec readOutline(ObjectReader& reader) {
-  sim::OutlineSpec outline;
+mesh::OutlineSpec readOutline(ObjectReader& reader) {
+  mesh::OutlineSpec outline;
   const json& points = reader.array("points", kMaxOutlinePoints);
   for (std::size_t i = 0; i < points.size(); ++i) {
     const json& p = points[i];
@@ -160,20 +162,21 @@ sim::ClothSettings readCloth(ObjectReader& reader, Model model, bool xpbd, long 
     if (reader.has("pins"))
       reader.fail("pins", "no pins on a drawn cloth (they name lattice columns and rows)", reader.raw("pins"));
     ObjectReader outlineReader = reader.object("outline");
-    sim::OutlineSpec outline = readOutline(outlineReader);
+    const mesh::OutlineSpec outline = readOutline(outlineReader);
     try {
-      const sim::OutlineCloth shape = sim::buildFromOutline(outline);
-      const auto particles = static_cast<long long>(shape.rest.particleCount());
+      mesh::OutlineMesh shape = mesh::meshOutline(outline);
+      const auto particles = static_cast<long long>(shape.positions.size());
       if (particles > particleBudget) {
         throw InputError(reader.source() + ": " + reader.pathOf("outline") + ": " + std::to_string(particles) +
                          " particles pass the limit of " + std::to_string(sim::kMaxParticles) +
                          " particles over all cloths");
       }
       particleBudget -= particles;
+      cloth.mesh = std::make_shared<const sim::LatticeMesh>(sim::LatticeMesh{
+          std::move(shape.positions), std::move(shape.triangles), std::move(shape.nodes), outline.spacing});
     } catch (const std::invalid_argument& error) {
       throw InputError(reader.source() + ": " + reader.pathOf("outline") + ": " + error.what());
     }
-    cloth.outline = std::move(outline);
     cloth.fabric = readFabric(reader, model);
     cloth.mass = reader.number("mass", 1.0, {1.0e-6, 1.0e6, false, "kg"});
     cloth.initialVelocity = reader.vec3("velocity", sim::Vec3{0.0}, 1000.0, "m/s");
@@ -442,7 +445,7 @@ Scene withFabric(const Scene& scene, std::string_view name) {
   Scene changed =
       scene.world.solver.model == Model::position ? scene : withModel(scene, Model::position, sim::Integrator::verlet);
   const auto sheet = [](const sim::ClothSettings& cloth) {
-    return cloth.outline || (cloth.lattice.columns >= 2 && cloth.lattice.rows >= 2);
+    return cloth.mesh || (cloth.lattice.columns >= 2 && cloth.lattice.rows >= 2);
   };
   for (sim::ClothSettings& cloth : changed.world.cloths) {
     if (!sheet(cloth)) continue;
@@ -468,7 +471,7 @@ sim::ClothSettings drawnClothTemplate(const Scene& scene) {
     sim::ClothSettings cloth = scene.world.cloths.front();
     cloth.pins.clear();
     cloth.masses.clear();
-    cloth.outline.reset();
+    cloth.mesh.reset();
     cloth.initialVelocity = sim::Vec3{0.0};
     cloth.initialSpin = sim::Vec3{0.0};
     return cloth;

@@ -103,10 +103,8 @@ Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source
     ObjectReader reader(cloths[c], "cloths." + std::to_string(c), source);
     sim::Cloth cloth;
     cloth.settings = c < snapshot.scene.world.cloths.size() ? snapshot.scene.world.cloths[c] : drawn;
-    if (cloth.settings.outline) {
-      // The mesh below is the cloth; its outline, pins and weights were for building it.
-      cloth.settings.outline.reset();
-    }
+    // The mesh below is the cloth; a drawn cloth's mesh, pins and weights were for building it.
+    cloth.settings.mesh.reset();
     cloth.settings.pins.clear();
     cloth.settings.masses.clear();
     try {

@@ -1,13 +1,17 @@
 #include "drape/sim/cloth.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "drape/sim/settings.hpp"
@@ -65,22 +69,149 @@ RestReal toRestLengthAtLeast(Real length) {
 
 namespace {
 
-void addConstraint(ClothRest& rest, ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
-  const RestReal restLength = toRestLength(glm::length(rest.restPosition(b) - rest.restPosition(a)));
-  // Lattice points are apart: they coincide only where the precision of the positions could not hold
-  // the spacing. The message names the lattice's key the spacing comes from, as the reader spells it.
-  if (restLength == 0.0f) {
-    const bool sameRow = a / rest.columns == b / rest.columns, sameColumn = a % rest.columns == b % rest.columns;
-    throw std::invalid_argument(std::string("grid.") +
-                                (sameRow      ? "width"
-                                 : sameColumn ? "height"
-                                              : "width") +
-                                ": the lattice spacing is too fine for the precision of its positions");
-  }
-  rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
+// A lattice whose spacing single precision cannot hold where its particles lie: the first pair of
+// neighbours that coincide at rest names the lattice's key the spacing comes from, as the reader
+// spells it.
+[[noreturn]] void latticeTooFine(const ClothRest& rest) {
+  const auto key = [&]() -> const char* {
+    const auto same = [&](ParticleIndex a, ParticleIndex b) { return rest.restOffsets[a] == rest.restOffsets[b]; };
+    for (int row = 0; row < rest.rows; ++row) {
+      for (int column = 0; column < rest.columns; ++column) {
+        const ParticleIndex p = rest.index(column, row);
+        if (column + 1 < rest.columns && same(p, rest.index(column + 1, row))) return "width";
+        if (row + 1 < rest.rows && same(p, rest.index(column, row + 1))) return "height";
+      }
+    }
+    return "width";
+  };
+  throw std::invalid_argument(std::string("grid.") + key() +
+                              ": the lattice spacing is too fine for the precision of its positions");
 }
 
 }  // namespace
+
+ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) {
+  const std::size_t n = mesh.positions.size();
+  if (mesh.nodes.size() != n) throw std::invalid_argument("a mesh needs one lattice node (or none) per particle");
+  ClothRest rest;
+  rest.setRestPositions(mesh.positions);  // before the rest lengths, which come from the rounded positions
+  rest.triangles.reserve(mesh.triangles.size());
+  for (const glm::uvec3& t : mesh.triangles) {
+    if (t.x >= n || t.y >= n || t.z >= n || t.x == t.y || t.y == t.z || t.z == t.x) {
+      throw std::invalid_argument("a mesh triangle has a corner out of range or twice");
+    }
+    rest.triangles.push_back(t);
+  }
+
+  // Nodes by (row, column), for finding a particle by its lattice position.
+  struct Node {
+    int row, column;
+    ParticleIndex particle;
+    bool operator<(const Node& o) const { return row != o.row ? row < o.row : column < o.column; }
+  };
+  std::vector<Node> byNode;
+  for (std::size_t p = 0; p < n; ++p) {
+    const glm::ivec2 node = mesh.nodes[p];
+    if (node == kNoNode) continue;
+    if (node.x < 0 || node.y < 0) throw std::invalid_argument("a mesh node has a negative column or row");
+    byNode.push_back({node.y, node.x, static_cast<ParticleIndex>(p)});
+  }
+  std::sort(byNode.begin(), byNode.end());
+  for (std::size_t i = 1; i < byNode.size(); ++i) {
+    if (!(byNode[i - 1] < byNode[i])) throw std::invalid_argument("two particles of a mesh stand for one lattice node");
+  }
+  const auto at = [&](int column, int row) -> std::optional<ParticleIndex> {
+    const auto found = std::lower_bound(byNode.begin(), byNode.end(), Node{row, column, 0});
+    if (found == byNode.end() || found->row != row || found->column != column) return std::nullopt;
+    return found->particle;
+  };
+  const auto onLattice = [&](ParticleIndex p) { return mesh.nodes[p] != kNoNode; };
+
+  // Edges as (low << 32 | high), sorted: the triangles', or a chain's lattice neighbours.
+  const auto key = [](ParticleIndex a, ParticleIndex b) {
+    return static_cast<std::uint64_t>(std::min(a, b)) << 32 | std::max(a, b);
+  };
+  std::vector<std::uint64_t> edges;
+  if (!mesh.triangles.empty()) {
+    edges.reserve(mesh.triangles.size() * 3);
+    for (const glm::uvec3& t : mesh.triangles) {
+      for (int k = 0; k < 3; ++k) edges.push_back(key(t[k], t[(k + 1) % 3]));
+    }
+  } else {
+    for (const Node& node : byNode) {
+      for (const auto next : {at(node.column + 1, node.row), at(node.column, node.row + 1)}) {
+        if (next) edges.push_back(key(node.particle, *next));
+      }
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  const auto isEdge = [&](ParticleIndex a, ParticleIndex b) {
+    return std::binary_search(edges.begin(), edges.end(), key(a, b));
+  };
+
+  const auto add = [&](ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
+    const RestReal restLength = toRestLength(glm::length(rest.restPosition(b) - rest.restPosition(a)));
+    if (restLength > 0.0f) rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
+  };
+
+  // Stretch: every edge but a cell's diagonals; the diagonals, by cell and which: (row, column, 0 for
+  // (column, row)-(column + 1, row + 1), 1 for (column + 1, row)-(column, row + 1)).
+  std::vector<std::array<int, 3>> diagonals;
+  for (const std::uint64_t edge : edges) {
+    const auto a = static_cast<ParticleIndex>(edge >> 32), b = static_cast<ParticleIndex>(edge & 0xffffffffu);
+    if (onLattice(a) && onLattice(b)) {
+      const glm::ivec2 d = mesh.nodes[b] - mesh.nodes[a];
+      if (std::abs(d.x) == 1 && std::abs(d.y) == 1) {
+        const glm::ivec2 low = glm::min(mesh.nodes[a], mesh.nodes[b]);
+        diagonals.push_back({low.y, low.x, d.x == d.y ? 0 : 1});
+        continue;
+      }
+    }
+    if (selection.stretch) add(ConstraintKind::stretch, a, b);
+  }
+  if (selection.shear) {
+    // A whole cell: two triangles within it that leave out opposite corners; its other diagonal too.
+    std::vector<std::array<int, 3>> corners;  // (row, column of the cell, corner left out: 0 1 / 2 3)
+    for (const glm::uvec3& t : mesh.triangles) {
+      if (!onLattice(t.x) || !onLattice(t.y) || !onLattice(t.z)) continue;
+      const glm::ivec2 a = mesh.nodes[t.x], b = mesh.nodes[t.y], c = mesh.nodes[t.z];
+      const glm::ivec2 low = glm::min(a, glm::min(b, c)), high = glm::max(a, glm::max(b, c));
+      if (high.x - low.x != 1 || high.y - low.y != 1) continue;
+      int missing = 0 + 1 + 2 + 3;
+      for (const glm::ivec2& v : {a, b, c}) missing -= (v.y - low.y) * 2 + (v.x - low.x);
+      corners.push_back({low.y, low.x, missing});
+    }
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+      const auto& [row, column, missing] = corners[i];
+      const auto& next = corners[i + 1];
+      if (next[0] != row || next[1] != column || missing + next[2] != 3) continue;
+      // Left out 0 and 3 (a split along 1-2, the anti-diagonal): the main diagonal too; else the anti.
+      diagonals.push_back({row, column, missing == 0 ? 0 : 1});
+    }
+    std::sort(diagonals.begin(), diagonals.end());
+    diagonals.erase(std::unique(diagonals.begin(), diagonals.end()), diagonals.end());
+    for (const auto& [row, column, which] : diagonals) {
+      const auto p00 = at(column, row), p11 = at(column + 1, row + 1);
+      const auto p10 = at(column + 1, row), p01 = at(column, row + 1);
+      if (which == 0 && p00 && p11) add(ConstraintKind::shear, *p00, *p11);
+      if (which == 1 && p10 && p01) add(ConstraintKind::shear, *p10, *p01);
+    }
+  }
+  if (selection.bend) {
+    for (const Node& node : byNode) {
+      for (const auto& [dc, dr] : {std::pair{1, 0}, std::pair{0, 1}}) {
+        const auto middle = at(node.column + dc, node.row + dr), end = at(node.column + 2 * dc, node.row + 2 * dr);
+        if (middle && end && isEdge(node.particle, *middle) && isEdge(*middle, *end) && !isEdge(node.particle, *end)) {
+          add(ConstraintKind::bend, node.particle, *end);
+        }
+      }
+    }
+  }
+  return rest;
+}
 
 ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
   if (spec.columns < 1 || spec.rows < 1 || spec.columns > kMaxLatticeSide || spec.rows > kMaxLatticeSide ||
@@ -92,58 +223,50 @@ ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {
     throw std::invalid_argument("lattice width and height must be positive");
   }
 
-  ClothRest rest;
-  rest.columns = spec.columns;
-  rest.rows = spec.rows;
+  LatticeMesh mesh;
   const Real dx = spec.columns > 1 ? spec.width / static_cast<Real>(spec.columns - 1) : 0.0;
   const Real dy = spec.rows > 1 ? spec.height / static_cast<Real>(spec.rows - 1) : 0.0;
+  mesh.spacing = spec.columns > 1 ? (spec.rows > 1 ? std::min(dx, dy) : dx) : dy;
   // Unit vectors of the lattice's column and row directions in the world.
   const Vec3 along{1.0, 0.0, 0.0};
   const Vec3 down = spec.plane == LatticePlane::xz ? Vec3{0.0, 0.0, 1.0} : Vec3{0.0, -1.0, 0.0};
-
-  std::vector<Vec3> positions;
-  positions.reserve(static_cast<std::size_t>(spec.columns) * spec.rows);
+  const auto count = static_cast<std::size_t>(spec.columns) * static_cast<std::size_t>(spec.rows);
+  mesh.positions.reserve(count);
+  mesh.nodes.reserve(count);
   for (int row = 0; row < spec.rows; ++row) {
     for (int column = 0; column < spec.columns; ++column) {
-      positions.push_back(spec.origin + along * (dx * static_cast<Real>(column)) +
-                          down * (dy * static_cast<Real>(row)));
+      mesh.positions.push_back(spec.origin + along * (dx * static_cast<Real>(column)) +
+                               down * (dy * static_cast<Real>(row)));
+      mesh.nodes.push_back({column, row});
     }
   }
-  // Rest lengths below come from the rounded positions, so that they agree with everything else
-  // measured at rest (tethers, self-collision distances).
-  rest.setRestPositions(positions);
-
   // Triangles wound counter-clockwise when seen from +y (xz plane) or +z (xy plane).
+  const auto index = [&](int column, int row) { return static_cast<ParticleIndex>(row * spec.columns + column); };
   for (int row = 0; row + 1 < spec.rows; ++row) {
     for (int column = 0; column + 1 < spec.columns; ++column) {
-      const ParticleIndex p00 = rest.index(column, row), p10 = rest.index(column + 1, row);
-      const ParticleIndex p01 = rest.index(column, row + 1), p11 = rest.index(column + 1, row + 1);
+      const ParticleIndex p00 = index(column, row), p10 = index(column + 1, row);
+      const ParticleIndex p01 = index(column, row + 1), p11 = index(column + 1, row + 1);
       if (spec.plane == LatticePlane::xz) {
-        rest.triangles.push_back({p00, p01, p10});
-        rest.triangles.push_back({p10, p01, p11});
+        mesh.triangles.push_back({p00, p01, p10});
+        mesh.triangles.push_back({p10, p01, p11});
       } else {
-        rest.triangles.push_back({p00, p01, p11});
-        rest.triangles.push_back({p00, p11, p10});
+        mesh.triangles.push_back({p00, p01, p11});
+        mesh.triangles.push_back({p00, p11, p10});
       }
     }
   }
-
-  for (int row = 0; row < spec.rows; ++row) {
-    for (int column = 0; column < spec.columns; ++column) {
-      const ParticleIndex p = rest.index(column, row);
-      if (selection.stretch) {
-        if (column + 1 < spec.columns) addConstraint(rest, ConstraintKind::stretch, p, rest.index(column + 1, row));
-        if (row + 1 < spec.rows) addConstraint(rest, ConstraintKind::stretch, p, rest.index(column, row + 1));
-      }
-      if (selection.shear && column + 1 < spec.columns && row + 1 < spec.rows) {
-        addConstraint(rest, ConstraintKind::shear, p, rest.index(column + 1, row + 1));
-        addConstraint(rest, ConstraintKind::shear, rest.index(column + 1, row), rest.index(column, row + 1));
-      }
-      if (selection.bend) {
-        if (column + 2 < spec.columns) addConstraint(rest, ConstraintKind::bend, p, rest.index(column + 2, row));
-        if (row + 2 < spec.rows) addConstraint(rest, ConstraintKind::bend, p, rest.index(column, row + 2));
-      }
-    }
+  ClothRest rest = constrainMesh(mesh, selection);
+  rest.columns = spec.columns;
+  rest.rows = spec.rows;
+  // Every neighbour pair joined, unless single precision could not hold the spacing somewhere.
+  const auto columns = static_cast<std::size_t>(spec.columns), rows = static_cast<std::size_t>(spec.rows);
+  const std::size_t stretch = (columns - 1) * rows + columns * (rows - 1);
+  const std::size_t shear = 2 * (columns - 1) * (rows - 1);
+  const std::size_t bend = (columns > 2 ? (columns - 2) * rows : 0) + (rows > 2 ? columns * (rows - 2) : 0);
+  if (rest.of(ConstraintKind::stretch).size() != (selection.stretch ? stretch : 0) ||
+      rest.of(ConstraintKind::shear).size() != (selection.shear ? shear : 0) ||
+      rest.of(ConstraintKind::bend).size() != (selection.bend ? bend : 0)) {
+    latticeTooFine(rest);
   }
   return rest;
 }

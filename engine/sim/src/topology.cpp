@@ -343,8 +343,8 @@ void build(Cloth& cloth) {
   // settings, snaps as the world it was taken from); else the median stretch rest length.
   const ClothSettings& settings = cloth.settings;
   topology.spacing = 0.0;
-  if (settings.outline) {
-    topology.spacing = settings.outline->spacing;
+  if (settings.mesh) {
+    topology.spacing = settings.mesh->spacing;
   } else {
     const LatticeSpec& l = settings.lattice;
     Real spacing = std::numeric_limits<Real>::infinity();

@@ -37,14 +37,19 @@ void require(bool condition, const std::string& what) {
   if (!condition) throw std::invalid_argument(what);
 }
 
-// Particles a lattice cloth will have; a drawn cloth's are known once it is built.
-long long latticeParticles(const ClothSettings& cloth) {
-  return cloth.outline ? 0 : static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
+// Particles the cloth will have: its lattice's, or its mesh's.
+long long particlesOf(const ClothSettings& cloth) {
+  return cloth.mesh ? static_cast<long long>(cloth.mesh->positions.size())
+                    : static_cast<long long>(cloth.lattice.columns) * cloth.lattice.rows;
 }
 
 void validateCloth(const ClothSettings& cloth, Model model) {
-  if (cloth.outline) require(cloth.pins.empty(), "a drawn cloth has no lattice to pin by column and row");
-  const long long clothParticles = cloth.outline ? 1 : latticeParticles(cloth);
+  if (cloth.mesh) {
+    require(cloth.pins.empty(), "a drawn cloth has no lattice to pin by column and row");
+    require(!cloth.mesh->triangles.empty(), "a drawn cloth's mesh needs a triangle");
+    require(finite(cloth.mesh->spacing) && cloth.mesh->spacing > 0.0, "a drawn cloth's spacing must be positive");
+  }
+  const long long clothParticles = particlesOf(cloth);
   require(clothParticles <= kMaxParticles, "too many particles");
   require(finite(cloth.mass) && cloth.mass > 0.0, "cloth mass must be positive");
   require(std::isfinite(static_cast<Real>(clothParticles) / cloth.mass) &&
@@ -61,7 +66,7 @@ void validateCloth(const ClothSettings& cloth, Model model) {
     }
     require(finite(m.compliance) && m.compliance >= 0.0, "constraint compliance must be finite and >= 0");
   }
-  if (cloth.outline) require(cloth.masses.empty(), "a drawn cloth has no lattice to weigh particles by column and row");
+  if (cloth.mesh) require(cloth.masses.empty(), "a drawn cloth has no lattice to weigh particles by column and row");
   for (const ParticleMass& m : cloth.masses) {
     require(m.column >= 0 && m.column < cloth.lattice.columns && m.row >= 0 && m.row < cloth.lattice.rows,
             "particle mass outside the lattice");
@@ -76,7 +81,7 @@ void validateCloth(const ClothSettings& cloth, Model model) {
   if (cloth.fabric) {
     const Fabric& f = *cloth.fabric;
     require(model == Model::position, "a fabric needs the position model");
-    if (!cloth.outline) {
+    if (!cloth.mesh) {
       require(cloth.lattice.columns >= 2 && cloth.lattice.rows >= 2,
               "a fabric needs a sheet, at least 2 x 2 particles");
     }
@@ -111,7 +116,7 @@ void validate(const WorldSettings& s) {
   long long particles = 0;
   for (const ClothSettings& cloth : s.cloths) {
     validateCloth(cloth, solver.model);
-    particles += latticeParticles(cloth);
+    particles += particlesOf(cloth);
   }
   require(particles <= kMaxParticles, "too many particles");
   const SelfCollisionSettings& self = s.selfCollision;
@@ -178,8 +183,7 @@ Cloth makeCloth(const ClothSettings& given, Model model) {
   const ConstraintSelection selection{used(settings.material(ConstraintKind::stretch)),
                                       used(settings.material(ConstraintKind::shear)),
                                       used(settings.material(ConstraintKind::bend))};
-  cloth.rest = settings.outline ? buildFromOutline(*settings.outline, selection).rest
-                                : buildLattice(settings.lattice, selection);
+  cloth.rest = settings.mesh ? constrainMesh(*settings.mesh, selection) : buildLattice(settings.lattice, selection);
   const std::size_t n = cloth.rest.particleCount();
   ParticleState& s = cloth.state;
   s.position.resize(n);
@@ -193,7 +197,7 @@ Cloth makeCloth(const ClothSettings& given, Model model) {
       s.mass[i] = toMass(m);
     }
     cloth.rest.bending = buildBendStencils(cloth.rest);
-  } else if (settings.outline) {
+  } else if (settings.mesh) {
     // By area: a third of each triangle's area to each of its corners, so the border is lighter.
     const std::vector<Real> area = particleAreas(cloth.rest);
     Real total = 0.0;

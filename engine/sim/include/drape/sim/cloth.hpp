@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "drape/sim/types.hpp"
@@ -112,7 +113,38 @@ std::vector<Real> particleAreas(const ClothRest& rest);
 // tear's tip) gets none.
 std::vector<BendStencil> buildBendStencils(const ClothRest& rest);
 
-// Builds the lattice. Throws std::invalid_argument if the spec is not a valid lattice.
+// (column, row) of a particle that stands for no lattice node (LatticeMesh::nodes).
+inline constexpr glm::ivec2 kNoNode{-1, -1};
+
+// A triangle mesh whose particles may stand for nodes of the seed's square lattice: a lattice's own
+// (buildLattice), or a drawn cloth's (drape/mesh/outline.hpp makes one from a stroke), whose border
+// particles off the lattice stand for none. A cell's diagonal neighbours are (column, row) and
+// (column + 1, row + 1), or (column + 1, row) and (column, row + 1).
+struct LatticeMesh {
+  std::vector<Vec3> positions;        // m, at rest
+  std::vector<glm::uvec3> triangles;  // counter-clockwise seen from the front
+  std::vector<glm::ivec2> nodes;      // each particle's (column, row) on the lattice, or kNoNode
+  Real spacing = 0.0;                 // m, the lattice's (a cut snaps at it)
+};
+
+// The one place the seed's constraints are made, for the lattice and for a drawn cloth, by lattice
+// position: every triangle edge between diagonal neighbours is shear, and so is the other diagonal
+// of a whole cell (split by its two triangles along one diagonal); every other triangle edge is
+// stretch (on a drawn cloth's border, edges between particles off the lattice are stretch as well);
+// bend joins particles two apart along a row or column where both stretch edges through the middle
+// particle exist and the two are not joined by an edge themselves. A mesh without triangles is a
+// chain: its edges are the lattice's row and column neighbours. Rest lengths are measured on the
+// rest positions as rounded (ClothRest::setRestPositions); an edge between particles that coincide
+// there gets no constraint. The lists are in lattice order: stretch by particle pair (a < b), shear
+// by cell, row by row, its diagonal (column, row)-(column + 1, row + 1) first, bend by first node,
+// row by row, along the row first. Border triangles without a lattice bend across them get no extra
+// bending constraint. Throws std::invalid_argument where the mesh is not one: nodes not one per
+// particle, a node off the lattice (negative) or stood for twice, a triangle with a corner out of
+// range or twice, a position not finite.
+ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection = {});
+
+// Builds the lattice (by constrainMesh). Throws std::invalid_argument if the spec is not a valid
+// lattice.
 ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection = {});
 
 }  // namespace drape::sim

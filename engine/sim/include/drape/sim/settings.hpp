@@ -2,13 +2,13 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string_view>
 #include <vector>
 
 #include "drape/sim/cloth.hpp"
 #include "drape/sim/collider.hpp"
-#include "drape/sim/outline.hpp"
 #include "drape/sim/types.hpp"
 
 namespace drape::sim {
@@ -121,9 +121,10 @@ struct Fabric {
 
 struct ClothSettings {
   LatticeSpec lattice;
-  // A drawn cloth: the outline, filled with a lattice (see outline.hpp), instead of `lattice`.
-  // Its mass is spread by area: each particle carries a third of its triangles' area.
-  std::optional<OutlineSpec> outline;
+  // A drawn cloth: this mesh instead of `lattice` (drape/mesh/outline.hpp makes one from a stroke;
+  // constrainMesh gives it its constraints). Its mass is spread by area: each particle carries a
+  // third of its triangles' area. Shared, not copied, by the settings' copies.
+  std::shared_ptr<const LatticeMesh> mesh;
   Real mass = 1.0;            // kg, spread evenly over the particles of a lattice
   Vec3 initialVelocity{0.0};  // m/s, of every unpinned particle at the start
   // rad/s: every unpinned particle also starts turning at this angular velocity about the cloth's

@@ -14,14 +14,33 @@
 
 #include <glm/geometric.hpp>
 
+#include "drape/mesh/outline.hpp"
 #include "drape/sim/cloth.hpp"
-#include "drape/sim/outline.hpp"
 #include "drape/sim/settings.hpp"
 
 namespace drape::sim {
 namespace {
 
+using mesh::OutlineSpec;
 using Points = std::vector<glm::dvec2>;
+
+// A drawn cloth's rest mesh as the engine makes it: the outline meshed (drape_mesh), then
+// constrained by lattice position (constrainMesh).
+struct OutlineCloth {
+  ClothRest rest;
+  Points loop;
+  bool tookLargestLoop = false;
+};
+
+OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selection = {}) {
+  mesh::OutlineMesh shape = mesh::meshOutline(spec);
+  OutlineCloth cloth;
+  cloth.rest = constrainMesh(
+      {std::move(shape.positions), std::move(shape.triangles), std::move(shape.nodes), spec.spacing}, selection);
+  cloth.loop = std::move(shape.loop);
+  cloth.tookLargestLoop = shape.tookLargestLoop;
+  return cloth;
+}
 
 // cross(b - a, c - a).y for points (x, 0, z) given as (x, z): positive is counter-clockwise seen from +y.
 double turn(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) { return (b.y - a.y) * (c.x - a.x) - (b.x - a.x) * (c.y - a.y); }
@@ -439,7 +458,7 @@ TEST(Outline, BadOutlinesSayWhy) {
   expectMessage({square(0.01), 0.05, 0.0}, "less than one cell");
   // 10 m x 10 m at 5 mm: about 2001^2 = 4 million particles.
   const std::string tooMany = messageOf({square(10.0), 0.005, 0.0});
-  EXPECT_NE(tooMany.find("particles, more than the limit of " + std::to_string(kMaxParticles)), std::string::npos)
+  EXPECT_NE(tooMany.find("particles, more than the limit of " + std::to_string(mesh::kMaxParticles)), std::string::npos)
       << tooMany;
   EXPECT_NE(tooMany.find("about 4004001 particles"), std::string::npos) << tooMany;
   expectMessage({square(1e300), 0.05, 0.0}, "spacings");

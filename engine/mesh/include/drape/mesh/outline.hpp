@@ -1,11 +1,14 @@
-// A cloth cut to an outline: the stroke a finger drew on the table, filled with the seed's lattice.
+// The outline mesher: the stroke a finger drew on the table, filled with the seed's lattice. GLM only:
+// it knows nothing of the engine; drape::sim::constrainMesh (drape/sim/cloth.hpp) gives the mesh its
+// stretch, shear and bend constraints by the lattice positions this leaves on its particles.
 //
 // The table is the x-z plane; a point of the stroke is (x, z) in metres. "Counter-clockwise seen from +y" is defined
 // by the same sign that makes the lattice's triangle normals point +y: points p0, p1, p2 are counter-clockwise when
 // cross(p1 - p0, p2 - p0).y > 0 with p = (x, 0, z), i.e. (p1.z - p0.z) (p2.x - p0.x) - (p1.x - p0.x) (p2.z - p0.z) > 0.
 // (Looking down from +y with x to the right, +z points down the page.)
 //
-// How a stroke becomes a rest mesh:
+// How a stroke becomes a mesh (src/loop.cpp: steps 1 to 3; src/fill.cpp: step 4; exact integer geometry in
+// src/exact.hpp):
 //  1. Clean. A non-finite point is an error. Points are held as integers on a grid of 1/4096 spacing, so that every
 //     later geometric decision is exact and cannot contradict another (the loop moves by at most 0.07% of a spacing).
 //     Points closer than spacing/4 to the previous kept point are dropped, the stroke is simplified with
@@ -29,44 +32,49 @@
 //     as before. Edges are flipped where that clearly improves a poor triangle (where the loop turns gently, three
 //     of its points can make one). A boundary particle then takes the lattice position (column, row) of the nearest
 //     unclaimed node outside the loop within spacing/2, so that the border joins in the lattice's constraints.
-//  5. Constrain, as the seed's lattice does, by lattice position: every triangle edge between diagonal neighbours is
-//     shear, the other diagonal of a whole cell (both of its triangles present) is shear too, every other triangle
-//     edge is stretch (on the border, edges between particles without a lattice position are stretch as well), and
-//     bend joins particles two apart along a row or column whose middle particle and both stretch edges exist.
-//     Rest lengths are measured on the rest positions. Border triangles without a lattice bend across them get no
-//     extra bending constraint (kept simple; the lattice bends reach the border wherever the border particles hold
-//     lattice positions).
+//     The mesh keeps each particle's lattice position (column, row), where it has one: every node of the lattice
+//     inside the loop, and the border particles that claimed one.
 #pragma once
 
 #include <vector>
 
 #include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 
-#include "drape/sim/cloth.hpp"
-#include "drape/sim/types.hpp"
+namespace drape::mesh {
 
-namespace drape::sim {
+// The most particles a mesh may have: the engine's limit over all cloths (drape::sim::kMaxParticles).
+inline constexpr long long kMaxParticles = 1 << 20;
 
 struct OutlineSpec {
   std::vector<glm::dvec2> points;  // the stroke, in the table plane: (x, z) in metres, as drawn (not closed)
-  Real spacing = 0.05;             // m, lattice spacing of the fill, > 0
-  Real height = 0.0;               // m, y of the cloth (it lies flat in the x-z plane)
+  double spacing = 0.05;           // m, lattice spacing of the fill, > 0
+  double height = 0.0;             // m, y of the cloth (it lies flat in the x-z plane)
 };
 
-struct OutlineCloth {
-  ClothRest rest;  // columns = rows = 0 (not a lattice); triangles counter-clockwise seen from +y
-  // The simple closed loop the cloth fills, counter-clockwise seen from +y, first point not repeated. Its corners are
-  // particles and the cloth's boundary edges lie on it.
+// (column, row) of a particle that stands for no lattice node.
+inline constexpr glm::ivec2 kNoNode{-1, -1};
+
+struct OutlineMesh {
+  std::vector<glm::dvec3> positions;  // m, every particle's, at y = height
+  std::vector<glm::uvec3> triangles;  // counter-clockwise seen from +y
+  // Each particle's lattice position (column, row), counted from the lattice's own origin (a node at
+  // the stroke's smallest x and z, less a margin), or kNoNode. Diagonal neighbours on the lattice are
+  // joined by its diagonal, as in the seed's lattice: (column + 1, row) with (column, row + 1).
+  std::vector<glm::ivec2> nodes;
+  // The simple closed loop the cloth fills, counter-clockwise seen from +y, first point not repeated.
+  // Its corners are particles and the cloth's boundary edges lie on it.
   std::vector<glm::dvec2> loop;
   bool tookLargestLoop = false;  // true when the stroke crossed itself and the largest simple loop was kept
 };
 
-// Builds the rest mesh of a cloth cut to the outline. Throws std::invalid_argument with a one-line message when the
-// outline cannot make a cloth: spacing or height not finite (spacing under 1e-9 m), a non-finite point, fewer than 3
-// distinct points, no enclosed area (collinear points), smaller than one cell (area under spacing^2), wider than
-// 2^17 spacings, more particles than kMaxParticles (estimated from area and perimeter before anything is allocated;
-// the message says how many), or too intricate (so much detail finer than the spacing that untangling or filling it
-// would take more than about half a second). Deterministic: the same spec gives the same cloth.
-OutlineCloth buildFromOutline(const OutlineSpec& spec, ConstraintSelection selection = {});
+// Meshes a cloth cut to the outline. Throws std::invalid_argument with a one-line message when the
+// outline cannot make a cloth: spacing or height not finite (spacing under 1e-9 m), a non-finite point,
+// fewer than 3 distinct points, no enclosed area (collinear points), smaller than one cell (area under
+// spacing^2), wider than 2^17 spacings or 1e38 m, more particles than kMaxParticles (estimated from area and
+// perimeter before anything is allocated; the message says how many), or too intricate (so much detail
+// finer than the spacing that untangling or filling it would take more than about half a second).
+// Deterministic: the same spec gives the same mesh.
+OutlineMesh meshOutline(const OutlineSpec& spec);
 
-}  // namespace drape::sim
+}  // namespace drape::mesh
