@@ -21,6 +21,9 @@ namespace drape::app {
 
 namespace {
 
+// Marks a stage's part among the plots' names (panels.stageNames).
+constexpr std::string_view kPartMark = "  ";
+
 const char* const kHelp[][2] = {
     {"touch", "a sticky finger (draws in Create mode, cuts in Cut mode); any number at once"},
     {"left drag", "a finger"},
@@ -306,14 +309,22 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     panels.intersections = sim::countIntersections(world).pairs;
   }
   panels.intersectionHistory.add(static_cast<float>(panels.intersections));
-  if (panels.stages.size() != world.profile().size()) {
-    panels.stages.assign(world.profile().size(), History{});
-    panels.stageNames.clear();
-    for (const sim::StageTiming& timing : world.profile()) panels.stageNames.emplace_back(sim::name(timing.stage));
+  // Each stage, then its parts (indented), as they ran in the last step.
+  std::vector<std::string> names;
+  std::vector<double> seconds;
+  for (const sim::StageTiming& timing : world.profile()) {
+    names.emplace_back(sim::name(timing.stage));
+    seconds.push_back(timing.lastSeconds);
+    for (const sim::StageTiming& part : timing.parts) {
+      names.push_back(std::string(kPartMark) + std::string(sim::name(part.stage)));
+      seconds.push_back(part.lastSeconds);
+    }
   }
-  for (std::size_t i = 0; i < world.profile().size(); ++i) {
-    panels.stages[i].add(static_cast<float>(world.profile()[i].lastSeconds * 1e3));
+  if (names != panels.stageNames) {
+    panels.stages.assign(names.size(), History{});
+    panels.stageNames = std::move(names);
   }
+  for (std::size_t i = 0; i < seconds.size(); ++i) panels.stages[i].add(static_cast<float>(seconds[i] * 1e3));
 
   panels.windows.clear();
   if (panels.closePopups) {  // Esc with a list open closes the list (and does not count towards quitting)
@@ -640,10 +651,16 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     ImGui::PlotLines("##step", stats.stepMilliseconds.data(), History::kLength, stats.stepMilliseconds.offset(),
                      overlay, 0.0f, std::max(1.0f, stats.stepMilliseconds.largest()), plot);
     for (std::size_t i = 0; i < panels.stages.size(); ++i) {
-      std::snprintf(overlay, sizeof overlay, "%s %.2f ms", panels.stageNames[i].c_str(), panels.stages[i].latest());
+      // A stage's parts under it, indented and lower.
+      const std::string& label = panels.stageNames[i];
+      const bool part = label.starts_with(kPartMark);
+      if (part) ImGui::Indent(24.0f);
+      std::snprintf(overlay, sizeof overlay, "%s %.2f ms", label.c_str() + (part ? kPartMark.size() : 0),
+                    panels.stages[i].latest());
       ImGui::PlotLines(("##stage" + std::to_string(i)).c_str(), panels.stages[i].data(), History::kLength,
                        panels.stages[i].offset(), overlay, 0.0f, std::max(0.5f, panels.stages[i].largest()),
-                       ImVec2(0.0f, 24.0f));
+                       ImVec2(0.0f, part ? 18.0f : 24.0f));
+      if (part) ImGui::Unindent(24.0f);
     }
     std::snprintf(overlay, sizeof overlay, "max strain %.2f %%", panels.maxStrain.latest());
     ImGui::PlotLines("##max", panels.maxStrain.data(), History::kLength, panels.maxStrain.offset(), overlay, 0.0f,

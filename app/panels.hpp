@@ -111,7 +111,7 @@ struct PanelState {
   int framesSinceCount = kIntersectionFrames;
   std::size_t intersections = 0;
   History intersectionHistory;
-  std::vector<History> stages;  // per stage of the world's pipeline, ms per frame
+  std::vector<History> stages;  // per stage of the world's pipeline and per part of one, ms per frame
   std::vector<std::string> stageNames;
 };
 

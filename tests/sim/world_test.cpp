@@ -47,6 +47,62 @@ TEST(Pipeline, EveryStageIsTimed) {
   EXPECT_GT(world.profile()[1].totalSeconds, 0.0);  // projecting 1000+ constraints takes some time
 }
 
+// The parts of a stage, each timed, in the order they first ran; their times add up to at most the
+// stage's (each is timed inside it, and a part inside another, as the tethers between the lines'
+// steps, is taken out of the other's).
+std::vector<Stage> partsOf(const World& world, Stage stage) {
+  std::vector<Stage> result;
+  for (const StageTiming& timing : world.profile()) {
+    if (timing.stage != stage) continue;
+    double sum = 0.0, lastSum = 0.0;
+    for (const StageTiming& part : timing.parts) {
+      result.push_back(part.stage);
+      EXPECT_GT(part.totalSeconds, 0.0) << name(part.stage);
+      EXPECT_GE(part.totalSeconds, part.lastSeconds) << name(part.stage);
+      EXPECT_TRUE(part.parts.empty()) << name(part.stage);
+      sum += part.totalSeconds;
+      lastSum += part.lastSeconds;
+    }
+    EXPECT_LE(sum, timing.totalSeconds * (1.0 + 1e-12)) << name(stage);
+    EXPECT_LE(lastSum, timing.lastSeconds * (1.0 + 1e-12)) << name(stage);
+  }
+  return result;
+}
+
+TEST(Pipeline, AStageThatDoesSeveralJobsTimesEachAsItsPart) {
+  // The seed's sweep: each kind in turn, after the plan.
+  World seed(test::hangingSheet(16, 4, 2));
+  seed.run(3);
+  EXPECT_EQ(partsOf(seed, Stage::projectConstraints),
+            (std::vector{Stage::plan, Stage::stretch, Stage::shear, Stage::bend}));
+
+  // The fast sweep on a sheet over a plane: the tethers first (and again between the lines' steps,
+  // which stretch's time does not count), bend and shear in batches, the lines, the contact planes.
+  WorldSettings settings = test::hangingSheet(16, 2, 2);
+  settings.solver.lines = true;
+  settings.solver.tethers = true;
+  settings.solver.tethersBetweenSteps = true;
+  ColliderSettings floor;
+  floor.shape = ColliderShape::plane;
+  floor.position = Vec3{0.0, 1.0, 0.0};
+  floor.normal = Vec3{0.0, 1.0, 0.0};
+  settings.colliders.push_back(floor);
+  World fast(settings);
+  fast.run(20);
+  EXPECT_EQ(
+      partsOf(fast, Stage::projectConstraints),
+      (std::vector{Stage::plan, Stage::tethers, Stage::bend, Stage::shear, Stage::stretch, Stage::contactPlanes}));
+
+  // Self-contact: the broad and narrow phases, the sweeps, the colliders' friction between them and the fail-safe.
+  settings.selfCollision.enabled = true;
+  World contact(settings);
+  contact.run(20);
+  EXPECT_EQ(partsOf(contact, Stage::selfContact), (std::vector{Stage::broadPhase, Stage::narrowPhase,
+                                                               Stage::contactSweep, Stage::friction, Stage::failSafe}));
+  // A stage of one job has none.
+  EXPECT_TRUE(partsOf(contact, Stage::verletIntegrate).empty());
+}
+
 template <typename Settings>
 void expectBitIdentical(const Settings& settings, int steps) {
   World a(settings), b(settings);

@@ -394,9 +394,10 @@ int bench(const BenchArguments& input) {
              << format("%.0fx", match->m.msPerFrame / drape->m.msPerFrame) << " |\n";
     }
     report << "\n## Where the time goes\n\n"
-           << "Milliseconds per frame in each stage of the pipeline; a stage a scene does not need is not in its "
-              "pipeline at all. `(step)` is the whole step: what it has beyond the stages is the pipeline's own "
-              "cost.\n\n";
+           << "Milliseconds per frame in each stage of the pipeline, and in brackets each part of a stage that "
+              "does several jobs, its own time (a part run inside another is not counted twice); a stage a scene "
+              "does not need is not in its pipeline at all. `(step)` is the whole step: what it has beyond the "
+              "stages is the pipeline's own cost.\n\n";
     for (const Row& row : rows) {
       const bool lastHang2 = row.n == arguments.sizes.back() && row.m.solver == "drape";
       if (!(row.n == 0 || lastHang2)) continue;
@@ -406,10 +407,8 @@ int bench(const BenchArguments& input) {
              << format("%.0f", static_cast<double>(row.m.bytes) / static_cast<double>(row.m.particles))
              << " bytes/particle):";
       double stages = 0.0, step = 0.0;
-      for (const auto& [stage, ms] : row.m.stageMs) {
-        report << " " << stage << " " << format("%.3f", ms) << ";";
-        (stage == "(step)" ? step : stages) += ms;
-      }
+      for (const bench::StageMs& stage : row.m.stageMs) (stage.stage == "(step)" ? step : stages) += stage.ms;
+      report << " " << bench::describe(row.m.stageMs);
       report << " outside the stages " << format("%.3f", step - stages) << " ms ("
              << format("%.1f", step > 0.0 ? 100.0 * (step - stages) / step : 0.0) << " %)\n";
     }

@@ -103,9 +103,7 @@ TouchRow playTouchCase(const TouchCase& c, int n, int threads, double budgetSeco
     if (last) break;
   }
   row.msPerFrame = 1e3 * stepping / std::max(row.framesRun, 1);
-  for (const sim::StageTiming& t : world.profile()) {
-    row.stageMs.emplace_back(std::string(sim::name(t.stage)), 1e3 * t.totalSeconds / std::max(row.framesRun, 1));
-  }
+  row.stageMs = bench::stageMs(world.profile(), row.framesRun);
   row.bytesPerParticle = static_cast<double>(bytes) / static_cast<double>(std::max<std::size_t>(row.particles, 1));
   row.hash = sim::stateHash(world);
   return row;
@@ -180,7 +178,7 @@ std::string touchSection(const std::vector<TouchRow>& rows, double budgetSeconds
   md << "\nWhere the time goes, ms per frame by stage:\n\n";
   for (const TouchRow& r : rows) {
     md << "- " << r.name << " " << r.n << ", " << r.threads << (r.threads == 1 ? " thread:" : " threads:");
-    for (const auto& [stage, ms] : r.stageMs) md << " " << stage << " " << format("%.3f", ms) << ";";
+    md << " " << bench::describe(r.stageMs);
     md << "\n";
   }
 

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "drape/bench/measure.hpp"
+
 namespace drape::cli {
 
 struct TouchCase {
@@ -31,8 +33,8 @@ struct TouchRow {
   int framesRun = 0;      // fewer where the time budget ran out
   double msPerFrame = 0.0;
   double msWorstFrame = 0.0;
-  std::vector<std::pair<std::string, double>> stageMs;  // per frame, by stage
-  double freeStrainEnd = 0.0;  // structural links with no end held or pinned: |x_b - x_a| / r - 1
+  std::vector<bench::StageMs> stageMs;  // per frame, by stage
+  double freeStrainEnd = 0.0;           // structural links with no end held or pinned: |x_b - x_a| / r - 1
   double freeStrainWorst = 0.0;
   std::size_t pairsEnd = 0;    // intersecting triangle pairs
   std::size_t pairsWorst = 0;  // over the counts (every kCountEvery frames and the last)

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
+#include <utility>
 
 #include "drape/bench/naive.hpp"
 #include "drape/sim/metrics.hpp"
@@ -23,6 +26,34 @@ void timing(Measurement& m, const std::vector<double>& seconds, double projectio
 }
 
 }  // namespace
+
+std::vector<StageMs> stageMs(const sim::Profile& profile, int frames) {
+  const double perFrame = 1e3 / std::max(frames, 1);
+  std::vector<StageMs> stages;
+  for (const sim::StageTiming& t : profile) {
+    StageMs stage{std::string(sim::name(t.stage)), t.totalSeconds * perFrame, {}};
+    for (const sim::StageTiming& part : t.parts) {
+      stage.parts.emplace_back(std::string(sim::name(part.stage)), part.totalSeconds * perFrame);
+    }
+    stages.push_back(std::move(stage));
+  }
+  return stages;
+}
+
+std::string describe(const std::vector<StageMs>& stages) {
+  std::string text;
+  char number[32];
+  for (const StageMs& stage : stages) {
+    std::snprintf(number, sizeof number, "%.3f", stage.ms);
+    text += (text.empty() ? "" : " ") + stage.stage + " " + number;
+    for (std::size_t k = 0; k < stage.parts.size(); ++k) {
+      std::snprintf(number, sizeof number, "%.3f", stage.parts[k].second);
+      text += (k == 0 ? " (" : ", ") + stage.parts[k].first + " " + number;
+    }
+    text += stage.parts.empty() ? ";" : ");";
+  }
+  return text;
+}
 
 Measurement measureWorld(const sim::WorldSettings& settings, int frames, int threads, int repeats) {
   Measurement m;
@@ -70,10 +101,8 @@ Measurement measureWorld(const sim::WorldSettings& settings, int frames, int thr
       }
     }
     m.tethers = world.tetherCount();
-    for (const sim::StageTiming& t : world.profile()) {
-      m.stageMs.emplace_back(std::string(sim::name(t.stage)), 1e3 * t.totalSeconds / frames);
-    }
-    m.stageMs.emplace_back("(step)", 1e3 * stepping / frames);
+    m.stageMs = stageMs(world.profile(), frames);
+    m.stageMs.push_back({"(step)", 1e3 * stepping / frames, {}});
   }
   timing(m, seconds, static_cast<double>(m.substeps) * m.iterations * static_cast<double>(m.constraints + m.tethers));
   return m;

@@ -605,7 +605,8 @@ bool stretchedBeyond(const Cloth& cloth, const SolverScratch& scratch, Real tole
 }  // namespace
 
 int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
-          Workers& workers, Real* looseLambda, const Extra& extra, const std::function<void()>& afterStep) {
+          Workers& workers, Real* looseLambda, const Extra& extra, const std::function<void()>& afterStep,
+          PartClock* parts) {
   // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
   // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
   // it does not (docs/performance.md). With geometric stiffness the first step is the full Newton
@@ -623,7 +624,12 @@ int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
     newtonStep(true);
     ++taken;
   }
-  solveLoose(cloth, scratch, stiffness, xpbd, alphaTilde, looseLambda);
+  if (!scratch.looseStretch.empty()) {
+    PartClock untimed;
+    (parts ? *parts : untimed).time(Stage::looseLinks, [&] {
+      solveLoose(cloth, scratch, stiffness, xpbd, alphaTilde, looseLambda);
+    });
+  }
   return taken;
 }
 

@@ -13,6 +13,7 @@
 #include <functional>
 
 #include "drape/sim/world.hpp"
+#include "part_clock.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::lines {
@@ -59,10 +60,10 @@ struct Extra {
 // while some link a step can move (one of its particles is free) is over extra.tolerance, up to
 // extra.steps more full steps, each followed by `afterStep`; then the loose stretch constraints.
 // Returns how many more steps it took. Whether a link is over is an OR over the lines, the same
-// however the workers share them.
+// however the workers share them. The loose constraints are timed by `parts` (Stage::looseLinks).
 int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
           Workers& workers, Real* looseLambda, const Extra& extra = {},
-          const std::function<void()>& afterStep = nullptr);
+          const std::function<void()>& afterStep = nullptr, PartClock* parts = nullptr);
 
 // At the start of a substep with geometric stiffness: the tension the last substep's steps added
 // up is what the first step uses, and that step starts the sum again.

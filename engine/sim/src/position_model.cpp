@@ -323,25 +323,38 @@ void bend(Cloth& cloth, Real h, SolverScratch& scratch) {
 
 namespace {
 
+Stage partOf(ConstraintKind kind) {
+  switch (kind) {
+    case ConstraintKind::stretch: return Stage::stretch;
+    case ConstraintKind::shear: return Stage::shear;
+    case ConstraintKind::bend: return Stage::bend;
+  }
+  return Stage::stretch;
+}
+
 // The seed's sweep: a fabric's bend stencils, then every kind in order (stretch, shear, bend), each
 // constraint after the one before it in the order the cloth lists them, then the tethers. One thread.
-void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch) {
+void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, PartClock& parts) {
   ParticleState& s = cloth.state;
   const bool xpbd = solver.xpbd || cloth.settings.fabric;
   // A fabric's bending first: the sweep ends with what the eye sees most, the cloth's length.
-  if (!cloth.rest.bending.empty()) bend(cloth, h, scratch);
+  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, h, scratch); });
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
     const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
-    if (xpbd) {
-      projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
-                            constraints.size(), material.compliance / (h * h));
-    } else {
-      projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
-    }
+    parts.time(partOf(kind), [&] {
+      if (xpbd) {
+        projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
+                              constraints.size(), material.compliance / (h * h));
+      } else {
+        projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
+      }
+    });
   }
-  if (!scratch.tethers.empty()) projectTethers(s, scratch.tethers, 0, scratch.tethers.particles());
+  if (!scratch.tethers.empty()) {
+    parts.time(Stage::tethers, [&] { projectTethers(s, scratch.tethers, 0, scratch.tethers.particles()); });
+  }
 }
 
 // The fast sweep (solver.lines): tethers first, then bend and shear in batches shared among the
@@ -349,20 +362,24 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
 // matters most to the eye, the cloth's length. With solver.tethersBetweenSteps the tethers are
 // projected again after each of the lines' Newton steps; with solver.extraLineSteps the lines take
 // more steps while a link is over solver.stretchTolerance (lines::solve).
-void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, Workers& workers) {
+void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, Workers& workers,
+                    PartClock& parts) {
   ParticleState& s = cloth.state;
   const auto tethers = [&] {
     if (scratch.tethers.empty()) return;
     // Shared out in blocks: the particles near the pins cost more (they are on a sphere, and the
     // rest inside both balls); on hang2 256 the first half of the sheet took 2.6 times as long as
     // the second.
-    workers.runShared(scratch.tethers.particles(), 512,
-                      [&](std::size_t begin, std::size_t end, int) { projectTethers(s, scratch.tethers, begin, end); });
+    parts.time(Stage::tethers, [&] {
+      workers.runShared(scratch.tethers.particles(), 512, [&](std::size_t begin, std::size_t end, int) {
+        projectTethers(s, scratch.tethers, begin, end);
+      });
+    });
   };
   tethers();
   const bool xpbd = solver.xpbd || cloth.settings.fabric;
   // A fabric's bend stencils on one thread (not yet in batches).
-  if (!cloth.rest.bending.empty()) bend(cloth, h, scratch);
+  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, h, scratch); });
   for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
     const std::size_t kindIndex = static_cast<std::size_t>(kind);
     const KindMaterial& material = cloth.settings.material(kind);
@@ -374,10 +391,12 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
       // With the tethers between the line steps both steps are full and the tethers follow each,
       // the last too: they keep the edges beside a pin from being pulled long by the last step.
       const bool between = solver.tethersBetweenSteps;
-      scratch.extraLineSteps +=
-          lines::solve(cloth, scratch, stiffness, xpbd, alphaTilde, solver.geometricStiffness, workers, looseLambda,
-                       {between, solver.extraLineSteps, solver.stretchTolerance},
-                       between ? std::function<void()>(tethers) : nullptr);
+      parts.time(Stage::stretch, [&] {
+        scratch.extraLineSteps +=
+            lines::solve(cloth, scratch, stiffness, xpbd, alphaTilde, solver.geometricStiffness, workers, looseLambda,
+                         {between, solver.extraLineSteps, solver.stretchTolerance},
+                         between ? std::function<void()>(tethers) : nullptr, &parts);
+      });
       continue;
     }
     const DistanceConstraint* constraints = cloth.rest.of(kind).data();
@@ -396,25 +415,27 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
       projectRange(s, constraints, begin, end, material.stiffness);
     };
     const std::vector<std::uint32_t>& start = scratch.batchStart[kindIndex];
-    for (std::size_t b = 0; b + 1 < start.size(); ++b) {
-      const std::size_t begin = start[b], end = start[b + 1];
-      if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
-        body(begin, end, false);  // its constraints may share particles: one thread, one after another
-      } else {
-        // Blocks of up to 2048 constraints, at least four a thread (hang2 64's batches hold 2000).
-        const std::size_t block =
-            std::clamp<std::size_t>((end - begin) / (4 * static_cast<std::size_t>(workers.threads())), 256, 2048);
-        workers.runShared(end - begin, block,
-                          [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last, true); });
+    parts.time(partOf(kind), [&] {
+      for (std::size_t b = 0; b + 1 < start.size(); ++b) {
+        const std::size_t begin = start[b], end = start[b + 1];
+        if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
+          body(begin, end, false);  // its constraints may share particles: one thread, one after another
+        } else {
+          // Blocks of up to 2048 constraints, at least four a thread (hang2 64's batches hold 2000).
+          const std::size_t block =
+              std::clamp<std::size_t>((end - begin) / (4 * static_cast<std::size_t>(workers.threads())), 256, 2048);
+          workers.runShared(end - begin, block,
+                            [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last, true); });
+        }
       }
-    }
+    });
   }
 }
 
 }  // namespace
 
 void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, bool contacts,
-                        Workers& workers) {
+                        Workers& workers, PartClock& parts) {
   if (solver.xpbd || cloth.settings.fabric) {
     for (ConstraintKind kind : kConstraintKinds) {
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
@@ -430,11 +451,11 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
   if (solver.lines && solver.geometricStiffness) lines::beginSubstep(scratch);
   for (int iteration = 0; iteration < solver.iterations; ++iteration) {
     if (solver.lines) {
-      sweepInBatches(cloth, solver, h, scratch, workers);
+      sweepInBatches(cloth, solver, h, scratch, workers, parts);
     } else {
-      sweepInOrder(cloth, solver, h, scratch);
+      sweepInOrder(cloth, solver, h, scratch, parts);
     }
-    if (contacts) contact::project(cloth, scratch);
+    if (contacts) parts.time(Stage::contactPlanes, [&] { contact::project(cloth, scratch); });
   }
 }
 

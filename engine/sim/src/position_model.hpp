@@ -9,6 +9,7 @@
 
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
+#include "part_clock.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::position {
@@ -45,9 +46,10 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
 // collider. With solver.xpbd each kind resists with its compliance instead (see settings.hpp); with
 // solver.lines the stretch constraints are solved a line at a time (lines.hpp; scratch.lines
 // built). Batches, lines and tethers are shared among the workers: the result does not depend on
-// how many there are.
+// how many there are. Each part (tethers, each kind, the loose links, the contact planes) is timed
+// by `parts`.
 void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, bool contacts,
-                        Workers& workers);
+                        Workers& workers, PartClock& parts);
 
 // Removes the kind's damping fraction of the relative velocity along each constraint, by moving
 // x_prev, conserving momentum.

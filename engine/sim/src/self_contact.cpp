@@ -1261,7 +1261,24 @@ void SelfContact::settle(std::vector<Cloth>& cloths, const std::vector<std::vect
 
 void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
                         const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
-                        Workers& workers) {
+                        Workers& workers, PartClock* clock) {
+  PartClock untimed;
+  PartClock& parts = clock ? *clock : untimed;
+  parts.time(Stage::broadPhase,
+             [&] { findPairsIfNeeded(cloths, scratch, settings, topologyVersion, substepsLeft, workers); });
+  parts.time(Stage::narrowPhase, [&] {
+    measurePairs(settings.distance, workers);
+    stats_.pairs = static_cast<std::int64_t>(pairs_.size());
+  });
+  parts.time(Stage::contactSweep, [&] {
+    sweep(settings.distance, settings.friction, scratch);
+    scatter(cloths);
+  });
+}
+
+void SelfContact::findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
+                                    const SelfCollisionSettings& settings, std::uint64_t topologyVersion,
+                                    int substepsLeft, Workers& workers) {
   const bool fresh = prepare(cloths, topologyVersion);
   gather(cloths, &scratch, nullptr);
   // The pairs found at a substep serve the rest of its step while every particle, at x0 and now,
@@ -1278,19 +1295,19 @@ void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& 
   } else {
     reused_ = true;
   }
-  measurePairs(settings.distance, workers);
-  stats_.pairs = static_cast<std::int64_t>(pairs_.size());
-  sweep(settings.distance, settings.friction, scratch);
-  scatter(cloths);
 }
 
-void SelfContact::finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers) {
-  std::size_t k = 0;
-  for (const Cloth& cloth : cloths) {
-    for (const Vec3& x : cloth.state.position) x_[k++] = x;
-  }
-  failSafe(settings.distance, workers);
-  scatter(cloths);
+void SelfContact::finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers,
+                         PartClock* clock) {
+  PartClock untimed;
+  (clock ? *clock : untimed).time(Stage::failSafe, [&] {
+    std::size_t k = 0;
+    for (const Cloth& cloth : cloths) {
+      for (const Vec3& x : cloth.state.position) x_[k++] = x;
+    }
+    failSafe(settings.distance, workers);
+    scatter(cloths);
+  });
 }
 
 }  // namespace drape::sim::contact

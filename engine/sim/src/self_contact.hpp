@@ -53,6 +53,7 @@
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
 #include "exact_triangles.hpp"
+#include "part_clock.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::contact {
@@ -65,9 +66,11 @@ class SelfContact {
   // this substep; the sweeps keep them too (a layer pushed down is not pushed through the table),
   // and what they push out counts into the contact's depth, as the constraint sweeps' does.
   // `substepsLeft`: in the step, this one included (the pairs found serve them all while they can).
+  // `parts` times the broad and the narrow phase, the sweeps and the fail-safe.
   void solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch, const SelfCollisionSettings& settings,
-             std::uint64_t topologyVersion, int substepsLeft, Workers& workers);
-  void finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers);
+             std::uint64_t topologyVersion, int substepsLeft, Workers& workers, PartClock* parts = nullptr);
+  void finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers,
+              PartClock* parts = nullptr);
   // Keeps a move made outside the substeps (a tear's relaxation, a cut putting particles on its
   // line) from passing cloth through cloth: the fail-safe alone, from `before` (per cloth, where each
   // particle was) to where the particles are, as if a substep had moved them so.
@@ -115,6 +118,11 @@ class SelfContact {
  private:
   // Makes the mesh again if the topology changed; true if it did.
   bool prepare(const std::vector<Cloth>& cloths, std::uint64_t topologyVersion);
+  // The broad phase: the pairs that may come within reach, found again where the last ones no
+  // longer serve.
+  void findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
+                         const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
+                         Workers& workers);
   void buildMesh(const std::vector<Cloth>& cloths);
   void buildTree();
   void fitTree();

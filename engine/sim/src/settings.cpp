@@ -69,6 +69,18 @@ std::string_view name(Stage stage) {
     case Stage::fingers: return "fingers";
     case Stage::guard: return "guard";
     case Stage::tear: return "tear";
+    case Stage::plan: return "plan";
+    case Stage::tethers: return "tethers";
+    case Stage::bendStencils: return "bend stencils";
+    case Stage::bend: return "bend";
+    case Stage::shear: return "shear";
+    case Stage::stretch: return "stretch";
+    case Stage::looseLinks: return "loose links";
+    case Stage::contactPlanes: return "contact planes";
+    case Stage::broadPhase: return "broad phase";
+    case Stage::narrowPhase: return "narrow phase";
+    case Stage::contactSweep: return "contact sweep";
+    case Stage::failSafe: return "fail-safe";
   }
   return "?";
 }

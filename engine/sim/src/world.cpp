@@ -299,9 +299,11 @@ void World::buildPipeline() {
   const Profile old = std::move(profile_);
   profile_.clear();
   const auto add = [&](Stage stage, bool perSubstep) {
-    StageTiming timing{stage, perSubstep};
+    StageTiming timing{stage, perSubstep, 0.0, 0.0, {}};
     for (const StageTiming& before : old) {
-      if (before.stage == stage) timing.totalSeconds = before.totalSeconds;
+      if (before.stage != stage) continue;
+      timing.totalSeconds = before.totalSeconds;
+      timing.parts = before.parts;
     }
     profile_.push_back(timing);
   };
@@ -522,7 +524,7 @@ void World::startHistory() {
   historyStarted_ = true;
 }
 
-void World::runStage(Stage stage) {
+void World::runStage(Stage stage, PartClock& parts) {
   const Real h = static_cast<Real>(substepDt());
   // Work over the whole world first: colliders move once per substep, and self-collision spans
   // every cloth at once.
@@ -534,11 +536,13 @@ void World::runStage(Stage stage) {
   if (stage == Stage::selfContact) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
     selfContact_->solve(cloths_, scratch_, settings_.selfCollision, topologyVersion_,
-                        settings_.solver.substeps - substep_, *workers_);
+                        settings_.solver.substeps - substep_, *workers_, &parts);
     if (!colliders_.empty()) {
-      for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, h, scratch_[c]);
+      parts.time(Stage::friction, [&] {
+        for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, h, scratch_[c]);
+      });
     }
-    selfContact_->finish(cloths_, settings_.selfCollision, *workers_);
+    selfContact_->finish(cloths_, settings_.selfCollision, *workers_, &parts);
     return;
   }
   if (stage == Stage::fingers) {
@@ -557,8 +561,8 @@ void World::runStage(Stage stage) {
         break;
       }
       case Stage::projectConstraints:
-        plan(c);
-        position::projectConstraints(cloth, settings_.solver, h, scratch, !colliders_.empty(), *workers_);
+        parts.time(Stage::plan, [&] { plan(c); });
+        position::projectConstraints(cloth, settings_.solver, h, scratch, !colliders_.empty(), *workers_, parts);
         break;
       case Stage::dampConstraints: position::dampConstraints(cloth); break;
       case Stage::clampTravel:
@@ -576,7 +580,19 @@ void World::runStage(Stage stage) {
       case Stage::selfCollide:  // world-wide, above
       case Stage::selfContact:
       case Stage::guard:  // once per step, in step()
-      case Stage::tear: break;
+      case Stage::tear:
+      case Stage::plan:  // parts, run inside their stages
+      case Stage::tethers:
+      case Stage::bendStencils:
+      case Stage::bend:
+      case Stage::shear:
+      case Stage::stretch:
+      case Stage::looseLinks:
+      case Stage::contactPlanes:
+      case Stage::broadPhase:
+      case Stage::narrowPhase:
+      case Stage::contactSweep:
+      case Stage::failSafe: break;
     }
   }
 }
@@ -661,13 +677,17 @@ StepStatus World::step() {
         4096);
   }
 
-  for (StageTiming& timing : profile_) timing.lastSeconds = 0.0;
+  for (StageTiming& timing : profile_) {
+    timing.lastSeconds = 0.0;
+    for (StageTiming& part : timing.parts) part.lastSeconds = 0.0;
+  }
   for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
     substep_ = substep;
     for (StageTiming& timing : profile_) {
       if (!timing.perSubstep) continue;
+      PartClock parts(timing);
       const auto start = Clock::now();
-      runStage(timing.stage);
+      runStage(timing.stage, parts);
       timing.lastSeconds += std::chrono::duration<double>(Clock::now() - start).count();
     }
   }
@@ -678,7 +698,10 @@ StepStatus World::step() {
     if (timing.stage == Stage::tear && !divergence_) tear();
     timing.lastSeconds += std::chrono::duration<double>(Clock::now() - start).count();
   }
-  for (StageTiming& timing : profile_) timing.totalSeconds += timing.lastSeconds;
+  for (StageTiming& timing : profile_) {
+    timing.totalSeconds += timing.lastSeconds;
+    for (StageTiming& part : timing.parts) part.totalSeconds += part.lastSeconds;
+  }
 
   if (divergence_) {
     for (std::size_t c = 0; c < cloths_.size(); ++c) {

@@ -7,9 +7,25 @@
 #include <utility>
 #include <vector>
 
+#include "drape/sim/pipeline.hpp"
 #include "drape/sim/settings.hpp"
 
 namespace drape::bench {
+
+// Wall time per frame in one stage of the pipeline, and in each of its parts (their own time, in
+// the order they first ran; sim::StageTiming::parts).
+struct StageMs {
+  std::string stage;
+  double ms = 0.0;
+  std::vector<std::pair<std::string, double>> parts;
+};
+
+// A world's profile as ms per frame, over `frames` frames.
+std::vector<StageMs> stageMs(const sim::Profile& profile, int frames);
+
+// "stage 1.234; stage 0.500 (part 0.200, part 0.100); ...": each stage with its ms per frame and
+// its parts' (%.3f).
+std::string describe(const std::vector<StageMs>& stages);
 
 struct Measurement {
   std::string solver;  // "drape" or "naive"
@@ -31,7 +47,7 @@ struct Measurement {
   std::size_t bytes = 0;        // what the solver keeps for the cloth: state, rest data, constraints, scratch
   std::vector<std::pair<std::string, std::size_t>> bytesBy;  // drape: the same by what it is for
   // drape: ms per frame in each pipeline stage, then "(step)": the whole step, stages and the rest
-  std::vector<std::pair<std::string, double>> stageMs;
+  std::vector<StageMs> stageMs;
 };
 
 // Drape's world. Every run times its steps alone; the first also takes the strain after each

@@ -2,7 +2,10 @@
 //
 // The world assembles its pipeline once from its settings: a stage the scene does not use (wind
 // pressure on a windless scene, constraint damping on undamped constraints, the other model's
-// integrator) is simply absent and costs nothing. Every stage is timed into a Profile.
+// integrator) is simply absent and costs nothing. Every stage is timed into a Profile, and so is
+// every part of a stage that does several jobs (projecting constraints: the plan, the tethers, each
+// kind's constraints, the loose links, the contact planes; self-contact: the broad and the narrow phase, the sweeps,
+// friction, the fail-safe), as the stage's parts.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +37,20 @@ enum class Stage : std::uint8_t {
   // every model, once per step
   guard,  // stop at the first non-finite or runaway position
   tear,   // split the mesh where a stretch constraint is past the tearing threshold
+  // parts of projectConstraints
+  plan,           // the solver's plan of a cloth, where its mesh or settings changed (batches, lines)
+  tethers,        // each particle into reach of the pins (long-range attachments)
+  bendStencils,   // a fabric's bending (its stencils, solved as one block)
+  bend,           // the bend constraints (in batches with solver.lines)
+  shear,          // the shear constraints (likewise)
+  stretch,        // the stretch constraints (whole lines at a time with solver.lines)
+  looseLinks,     // with solver.lines: the stretch links on no line, one at a time
+  contactPlanes,  // each particle back onto its collider contacts' planes, after each sweep
+  // parts of selfContact (friction, above, is its part too)
+  broadPhase,    // the vertex-triangle and edge-edge pairs that may come within reach (a tree of boxes)
+  narrowPhase,   // each pair's closest points, and whether it is near enough to push
+  contactSweep,  // the pairs' constraints, swept
+  failSafe,      // no step makes two triangles pass through each other
 };
 
 std::string_view name(Stage stage);
@@ -43,6 +60,10 @@ struct StageTiming {
   bool perSubstep;            // runs once per substep (else once per step)
   double lastSeconds = 0.0;   // wall time spent in the last step
   double totalSeconds = 0.0;  // wall time since the world was made
+  // The stage's parts, in the order they first ran, each with its own time (a part that runs
+  // inside another, as the tethers between the lines' steps, is taken out of the other's): they add
+  // up to at most the stage's time; what is left is the stage's own glue.
+  std::vector<StageTiming> parts;
 };
 
 using Profile = std::vector<StageTiming>;

@@ -74,6 +74,7 @@ struct SelfContactStats {
 };
 
 class Workers;
+class PartClock;
 namespace contact {
 class SelfContact;
 }
@@ -221,7 +222,7 @@ class World {
                                               std::vector<ParticleInsert>&)>& change);
   void grab(Finger& finger, std::size_t cloth, ParticleIndex nearest);
   std::size_t particleCount() const;
-  void runStage(Stage stage);
+  void runStage(Stage stage, PartClock& parts);
   void startHistory();
   void startHistory(std::size_t cloth);
   void moveColliders();
