@@ -18,6 +18,7 @@
 
 #include "batches.hpp"
 #include "distance_wide.hpp"
+#include "drape/bench/hang2.hpp"
 #include "drape/mesh/outline.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
@@ -665,12 +666,17 @@ TEST(Tethers, TheLensProjectionIsTheNearestPointInBothBalls) {
 
 // ---- the fast sweep as a whole ---------------------------------------------------------------
 
+// hang2 (assets/scenes/hang2.json) at N x N with `substeps` substeps of one sweep: whole lines and
+// tethers, and neither geometric stiffness, nor the tethers between the line steps, nor extra line
+// steps unless a test asks for them.
 WorldSettings fastSheet(int n, int substeps) {
-  WorldSettings world = test::hangingSheet(n, 1, substeps);
-  world.solver.lines = true;
-  world.solver.tethers = true;
-  for (ConstraintKind kind : kConstraintKinds) world.cloths[0].material(kind) = {1.0, 0.0};
-  return world;
+  bench::Hang2Solver solver;
+  solver.substeps = substeps;
+  solver.iterations = 1;
+  solver.lines = solver.tethers = true;
+  solver.geometricStiffness = solver.tethersBetweenSteps = false;
+  solver.extraLineSteps = 0;
+  return bench::hang2(n, solver);
 }
 
 TEST(FastSweep, OneTwoOrFiveThreadsGiveTheSameResultBitForBit) {

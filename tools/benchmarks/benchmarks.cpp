@@ -30,20 +30,13 @@ using namespace drape;
 
 constexpr int kFrames = 120;
 
-// The cheapest sweep that keeps hang2 within 5 % strain at every frame (drape-cli bench finds it;
-// see docs/performance.md): one substep with the tethers after each line step, and up to two
-// more line steps where an edge is still over 4 %, at every N.
-bench::Hang2Solver solverFor(int) {
-  bench::Hang2Solver solver;
-  solver.substeps = 1;
-  solver.tethersBetweenSteps = true;
-  return solver;
-}
-
 void Hang2(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
-  const sim::WorldSettings settings = bench::hang2(n, solverFor(n));
+  // As the scene file solves it: one substep with the tethers after each line step, and up to four
+  // more line steps where an edge is still over 4 % (the cheapest sweep within 5 % at every frame
+  // that drape-cli bench finds at every N: docs/performance.md).
+  const sim::WorldSettings settings = bench::hang2(n);
   double strain = 0.0;
   for (auto _ : state) {
     state.PauseTiming();

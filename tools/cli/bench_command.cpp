@@ -172,7 +172,7 @@ int bench(const BenchArguments& input) {
       const sim::WorldSettings world = bench::hang2(n, solver);
       for (int t : arguments.threads) {
         rows.push_back({"hang2", n, bench::measureWorld(world, arguments.frames, t, arguments.repeats),
-                        solver.tethersBetweenSteps});
+                        world.solver.tethersBetweenSteps});
         progress(rows.back());
       }
       for (int it : arguments.naiveIterations) {
@@ -243,7 +243,7 @@ int bench(const BenchArguments& input) {
               "substeps of one sweep (how many for each N is below). Where marked (t) the sweep projects the tethers "
               "again after each of the two Newton steps, and both are full ones (`tethersBetweenSteps`). "
            << (arguments.extraLineSteps > 0
-                   ? "Where an edge is still more than " + percent(bench::Hang2Solver{}.stretchTolerance) +
+                   ? "Where an edge is still more than " + percent(bench::hang2(2).solver.stretchTolerance) +
                          " long after them, the sweep takes up to " + std::to_string(arguments.extraLineSteps) +
                          " more line steps (`extraLineSteps`, `stretchTolerance`); \"extra steps\" counts them per "
                          "frame. "

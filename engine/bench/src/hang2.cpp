@@ -1,26 +1,36 @@
 #include "drape/bench/hang2.hpp"
 
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/scene/scene.hpp"
+
 namespace drape::bench {
 
+namespace embedded {
+extern const std::string_view hang2_json;  // assets/scenes/hang2.json, as built (cmake/embed.cmake)
+}
+
 sim::WorldSettings hang2(int n, const Hang2Solver& solver) {
-  sim::WorldSettings world;
-  world.solver.model = sim::Model::position;
-  world.solver.dt = 1.0 / 60.0;
-  world.solver.substeps = solver.substeps;
-  world.solver.iterations = solver.iterations;
-  world.solver.lines = solver.lines;
-  world.solver.tethers = solver.tethers;
-  world.solver.geometricStiffness = solver.geometricStiffness;
-  world.solver.tethersBetweenSteps = solver.tethersBetweenSteps;
-  world.solver.extraLineSteps = solver.extraLineSteps;
-  world.solver.stretchTolerance = solver.stretchTolerance;
-  world.gravity = {0.0, -9.81, 0.0};
-  sim::ClothSettings cloth;
-  cloth.lattice = {n, n, 1.0, 1.0, sim::Vec3{0.0, 1.5, 0.0}, sim::LatticePlane::xz};
-  cloth.mass = 1.0;
-  for (sim::ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = {1.0, 0.0, 0.0};
+  if (n < 2) throw std::invalid_argument("hang2 needs at least 2 x 2 particles, not " + std::to_string(n));
+  static const sim::WorldSettings file =
+      scene::parseScene(nlohmann::json::parse(embedded::hang2_json), "assets/scenes/hang2.json").world;
+  sim::WorldSettings world = file;
+  sim::ClothSettings& cloth = world.cloths.at(0);
+  cloth.lattice.columns = cloth.lattice.rows = n;
   cloth.pins = {{0, 0, std::nullopt}, {n - 1, 0, std::nullopt}};
-  world.cloths.push_back(cloth);
+  sim::SolverSettings& s = world.solver;
+  s.substeps = solver.substeps.value_or(s.substeps);
+  s.iterations = solver.iterations.value_or(s.iterations);
+  s.lines = solver.lines.value_or(s.lines);
+  s.tethers = solver.tethers.value_or(s.tethers);
+  s.geometricStiffness = solver.geometricStiffness.value_or(s.geometricStiffness);
+  s.tethersBetweenSteps = solver.tethersBetweenSteps.value_or(s.tethersBetweenSteps);
+  s.extraLineSteps = solver.extraLineSteps.value_or(s.extraLineSteps);
+  s.stretchTolerance = solver.stretchTolerance.value_or(s.stretchTolerance);
   return world;
 }
 
