@@ -20,6 +20,7 @@
 
 #include "drape/sim/cloth.hpp"
 #include "drape/sim/state.hpp"
+#include "solver_scratch.hpp"
 
 namespace drape::sim::bending {
 

@@ -13,6 +13,7 @@
 #include "drape/sim/settings.hpp"
 #include "drape/sim/state.hpp"
 #include "drape/sim/world.hpp"
+#include "solver_scratch.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::contact {

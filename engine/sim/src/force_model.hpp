@@ -6,6 +6,7 @@
 #include "drape/sim/settings.hpp"
 #include "drape/sim/state.hpp"
 #include "drape/sim/world.hpp"
+#include "solver_scratch.hpp"
 
 namespace drape::sim::force {
 

@@ -14,6 +14,7 @@
 
 #include "drape/sim/world.hpp"
 #include "part_clock.hpp"
+#include "solver_scratch.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::lines {

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "drape/sim/state.hpp"
+#include "solver_scratch.hpp"
 
 namespace drape::sim::lines {
 

@@ -10,6 +10,7 @@
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
 #include "part_clock.hpp"
+#include "solver_scratch.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::position {

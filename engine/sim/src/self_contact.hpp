@@ -54,6 +54,7 @@
 #include "drape/sim/world.hpp"
 #include "exact_triangles.hpp"
 #include "part_clock.hpp"
+#include "solver_scratch.hpp"
 #include "workers.hpp"
 
 namespace drape::sim::contact {

@@ -1,5 +1,7 @@
 #include "drape/sim/state.hpp"
 
+#include "solver_scratch.hpp"
+
 #include <limits>
 #include <stdexcept>
 

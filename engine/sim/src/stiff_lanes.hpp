@@ -18,6 +18,7 @@
 #endif
 
 #include "drape/sim/state.hpp"
+#include "solver_scratch.hpp"
 
 namespace drape::sim::lines {
 namespace {

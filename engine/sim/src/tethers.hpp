@@ -11,6 +11,7 @@
 
 #include "drape/sim/state.hpp"
 #include "drape/sim/world.hpp"
+#include "solver_scratch.hpp"
 
 namespace drape::sim {
 

@@ -21,6 +21,7 @@
 #include "lines.hpp"
 #include "position_model.hpp"
 #include "self_contact.hpp"
+#include "solver_scratch.hpp"
 #include "tethers.hpp"
 #include "topology.hpp"
 #include "workers.hpp"
@@ -248,7 +249,10 @@ std::uint64_t nextTopologyVersion() {
 }
 
 World::World(WorldSettings settings)
-    : settings_(std::move(settings)), topologyVersion_(nextTopologyVersion()), workers_(std::make_unique<Workers>(1)) {
+    : settings_(std::move(settings)),
+      topologyVersion_(nextTopologyVersion()),
+      selfCollisionScratch_(std::make_unique<SelfCollisionScratch>()),
+      workers_(std::make_unique<Workers>(1)) {
   validate(settings_);
   for (std::size_t c = 0; c < settings_.cloths.size(); ++c) {
     try {
@@ -445,7 +449,7 @@ MemoryUse World::memoryUse() const {
   }
   for (const std::vector<Vec3>& good : lastGood_) m.guard += bytes(good);
   for (const std::vector<std::uint8_t>& held : held_) m.solver += bytes(held);
-  const SelfCollisionScratch& h = selfCollisionScratch_;
+  const SelfCollisionScratch& h = *selfCollisionScratch_;
   m.solver += bytes(h.owner) + bytes(h.cell) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
   for (const auto& pairs : h.pairs) m.solver += bytes(pairs);
   if (selfContact_) m.solver += selfContact_->bytes();
@@ -532,7 +536,7 @@ void World::runStage(Stage stage, PartClock& parts) {
   // every cloth at once.
   if (stage == Stage::collide || stage == Stage::collideForces) moveColliders();
   if (stage == Stage::selfCollide) {
-    contact::selfCollide(cloths_, settings_.selfCollision, selfCollisionScratch_, *workers_);
+    contact::selfCollide(cloths_, settings_.selfCollision, *selfCollisionScratch_, *workers_);
     return;
   }
   if (stage == Stage::selfContact) {

@@ -74,6 +74,8 @@ struct SelfContactStats {
 };
 
 class Workers;
+struct SolverScratch;  // src/solver_scratch.hpp: the solver's own
+struct SelfCollisionScratch;
 class PartClock;
 namespace contact {
 class SelfContact;
@@ -244,8 +246,8 @@ class World {
   std::optional<Divergence> divergence_;
   std::vector<SolverScratch> scratch_;  // per cloth
   std::vector<Collider> colliders_;
-  SelfCollisionScratch selfCollisionScratch_;
-  std::unique_ptr<contact::SelfContact> selfContact_;  // made at the first substep that needs it
+  std::unique_ptr<SelfCollisionScratch> selfCollisionScratch_;  // made with the world
+  std::unique_ptr<contact::SelfContact> selfContact_;           // made at the first substep that needs it
   // Self-contact is on: a held particle may lag its finger where the finger would drive it through
   // cloth (moveFingers).
   bool selfContactHolds_ = false;
