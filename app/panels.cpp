@@ -578,7 +578,12 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       tip("how far apart two layers of cloth are kept");
     }
   }
-  if (changed) session.tune(tuned);
+  if (changed) {
+    // A key switched off takes the keys that need it with it (unticking lines: geometric stiffness,
+    // tethers between line steps, extra steps): the engine's one rule for it.
+    tuned.solver = sim::consistent(tuned.solver);
+    session.tune(tuned);
+  }
 
   if (ImGui::CollapsingHeader("View")) {
     ImGui::Checkbox("woven", &panels.frameOptions.woven);

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -149,6 +151,56 @@ TEST(Pipeline, TheSolverIsPlannedWhenTheWorldChangesNotWhileItSteps) {
   world.addCloth(settings.cloths[0]);
   world.removeCloth(0);
   stepAndCheck("a cloth removed");
+}
+
+// Which solver keys go together is said once (sim::conflict); consistent() turns off what does
+// not go, and changes nothing that does. Every combination of the keys involved.
+TEST(SolverKeys, EveryCombinationIsJudgedOnceAndMadeConsistentByTurningKeysOff) {
+  int valid = 0;
+  for (int bits = 0; bits < 256; ++bits) {
+    SolverSettings s;
+    s.model = bits & 1 ? Model::force : Model::position;
+    s.integrator = bits & 2 ? Integrator::rk4 : Integrator::verlet;
+    s.xpbd = bits & 4;
+    s.tethers = bits & 8;
+    s.lines = bits & 16;
+    s.geometricStiffness = bits & 32;
+    s.tethersBetweenSteps = bits & 64;
+    s.extraLineSteps = bits & 128 ? 3 : 0;
+    const std::optional<SolverConflict> c = conflict(s);
+    const bool positionOnly = s.xpbd || s.tethers || s.lines || s.geometricStiffness || s.tethersBetweenSteps;
+    const bool goes = (s.model == Model::force ? !positionOnly : s.integrator == Integrator::verlet) &&
+                      (s.lines || (!s.geometricStiffness && s.extraLineSteps == 0)) &&
+                      (!s.tethersBetweenSteps || (s.lines && s.tethers));
+    EXPECT_EQ(!c.has_value(), goes) << "combination " << bits;
+    const SolverSettings made = consistent(s);
+    EXPECT_FALSE(conflict(made).has_value()) << "combination " << bits;
+    if (goes) {
+      ++valid;
+      EXPECT_EQ(made.integrator, s.integrator);
+      EXPECT_EQ(made.lines, s.lines);
+      EXPECT_EQ(made.geometricStiffness, s.geometricStiffness);
+      EXPECT_EQ(made.tethersBetweenSteps, s.tethersBetweenSteps);
+      EXPECT_EQ(made.extraLineSteps, s.extraLineSteps);
+    }
+    // Turning off only: nothing consistent() leaves on was off.
+    EXPECT_LE(made.lines, s.lines);
+    EXPECT_LE(made.tethers, s.tethers);
+    EXPECT_LE(made.geometricStiffness, s.geometricStiffness);
+    EXPECT_LE(made.tethersBetweenSteps, s.tethersBetweenSteps);
+    EXPECT_LE(made.extraLineSteps, s.extraLineSteps);
+  }
+  EXPECT_GT(valid, 10);
+  // The world refuses a combination that does not go, naming the key.
+  WorldSettings settings = test::hangingSheet(4, 1, 1);
+  settings.solver.geometricStiffness = true;
+  try {
+    World world(settings);
+    ADD_FAILURE() << "geometric stiffness without lines was taken";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("solver.geometricStiffness: false unless \"lines\" is true", 0), 0u)
+        << error.what();
+  }
 }
 
 template <typename Settings>

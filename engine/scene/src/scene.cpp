@@ -253,10 +253,6 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.model = *sim::parseModel(solver.choice("model", "position", {"position", "force"}));
     world.solver.integrator = *sim::parseIntegrator(
         solver.choice("integrator", "verlet", {"explicit-euler", "symplectic-euler", "verlet", "midpoint", "rk4"}));
-    if (world.solver.model == Model::position && world.solver.integrator != sim::Integrator::verlet) {
-      solver.fail("integrator", "\"verlet\" for the position model (the others belong to \"model\": \"force\")",
-                  solver.raw("integrator"));
-    }
     world.solver.dt = solver.number("dt", world.solver.dt, {1.0e-6, 1.0, false, "s"});
     world.solver.substeps = solver.integer("substeps", world.solver.substeps, 1, sim::kMaxSubsteps);
     world.solver.iterations = solver.integer("iterations", world.solver.iterations, 0, sim::kMaxIterations);
@@ -269,26 +265,10 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.extraLineSteps = solver.integer("extraLineSteps", 0, 0, sim::kMaxExtraLineSteps);
     world.solver.stretchTolerance =
         solver.number("stretchTolerance", world.solver.stretchTolerance, {0.0, 10.0, false, ""});
-    if (world.solver.model != Model::position) {
-      for (const char* key : {"xpbd", "tethers", "lines", "geometricStiffness", "tethersBetweenSteps"}) {
-        if (solver.has(key) && solver.boolean(key, false)) {
-          solver.fail(key, "false for the force model (it belongs to the position model)", solver.raw(key));
-        }
-      }
-    }
-    if (world.solver.extraLineSteps > 0 && !world.solver.lines) {
-      solver.fail("extraLineSteps", "0 unless \"lines\" is true (it adds steps to the line solve)",
-                  solver.raw("extraLineSteps"));
-    }
-    if (world.solver.geometricStiffness && !world.solver.lines) {
-      solver.fail("geometricStiffness", "false unless \"lines\" is true (it is part of the line solve)",
-                  solver.raw("geometricStiffness"));
-    }
-    if (world.solver.tethersBetweenSteps && !(world.solver.lines && world.solver.tethers)) {
-      solver.fail("tethersBetweenSteps",
-                  "false unless \"lines\" and \"tethers\" are true (it projects the tethers between the line "
-                  "solve's steps)",
-                  solver.raw("tethersBetweenSteps"));
+    // Keys that do not go with the others (the engine's one rule for it: sim::conflict).
+    if (const std::optional<sim::SolverConflict> c = sim::conflict(world.solver)) {
+      const std::string key(c->key);
+      solver.fail(key, c->value, solver.raw(key));
     }
     solver.finish();
   }
@@ -395,13 +375,10 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
     for (sim::ClothSettings& cloth : changed.world.cloths) {
       for (ConstraintKind kind : sim::kConstraintKinds) cloth.material(kind) = defaultMaterial(model, kind);
     }
-    if (model == Model::force) {
-      solver.xpbd = solver.tethers = solver.lines = solver.geometricStiffness = solver.tethersBetweenSteps = false;
-      solver.extraLineSteps = 0;
-    }
   }
   solver.model = model;
   solver.integrator = integrator;
+  solver = sim::consistent(solver);
   if (model == Model::force) {
     try {
       const double longest = 0.9 * sim::World(changed.world).stableForceSubstep();

@@ -49,6 +49,44 @@ std::optional<SelfContactMethod> parseSelfContactMethod(std::string_view text) {
   return lookupValue<SelfContactMethod>(kSelfContactNames, text);
 }
 
+std::optional<SolverConflict> conflict(const SolverSettings& solver) {
+  if (solver.model == Model::position && solver.integrator != Integrator::verlet) {
+    return SolverConflict{"integrator",
+                          "\"verlet\" for the position model (the others belong to \"model\": \"force\")"};
+  }
+  if (solver.model == Model::force) {
+    constexpr std::string_view kPositionOnly = "false for the force model (it belongs to the position model)";
+    if (solver.xpbd) return SolverConflict{"xpbd", kPositionOnly};
+    if (solver.tethers) return SolverConflict{"tethers", kPositionOnly};
+    if (solver.lines) return SolverConflict{"lines", kPositionOnly};
+    if (solver.geometricStiffness) return SolverConflict{"geometricStiffness", kPositionOnly};
+    if (solver.tethersBetweenSteps) return SolverConflict{"tethersBetweenSteps", kPositionOnly};
+  }
+  if (solver.extraLineSteps > 0 && !solver.lines) {
+    return SolverConflict{"extraLineSteps", "0 unless \"lines\" is true (it adds steps to the line solve)"};
+  }
+  if (solver.geometricStiffness && !solver.lines) {
+    return SolverConflict{"geometricStiffness", "false unless \"lines\" is true (it is part of the line solve)"};
+  }
+  if (solver.tethersBetweenSteps && !(solver.lines && solver.tethers)) {
+    return SolverConflict{"tethersBetweenSteps",
+                          "false unless \"lines\" and \"tethers\" are true (it projects the tethers between the "
+                          "line solve's steps)"};
+  }
+  return std::nullopt;
+}
+
+SolverSettings consistent(SolverSettings solver) {
+  if (solver.model == Model::position) solver.integrator = Integrator::verlet;
+  if (solver.model == Model::force) solver.xpbd = solver.tethers = solver.lines = false;
+  if (!solver.lines) {
+    solver.geometricStiffness = solver.tethersBetweenSteps = false;
+    solver.extraLineSteps = 0;
+  }
+  if (!solver.tethers) solver.tethersBetweenSteps = false;
+  return solver;
+}
+
 std::string_view name(Stage stage) {
   switch (stage) {
     case Stage::windPressure: return "wind pressure";

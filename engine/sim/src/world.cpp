@@ -109,6 +109,9 @@ void validate(const WorldSettings& s) {
           "solver.extraLineSteps is out of range");
   require(finite(solver.stretchTolerance) && solver.stretchTolerance >= 0.0,
           "solver.stretchTolerance must be finite and >= 0");
+  if (const std::optional<SolverConflict> c = conflict(solver)) {
+    throw std::invalid_argument("solver." + std::string(c->key) + ": " + std::string(c->value));
+  }
   require(finite(s.gravity), "gravity must be finite");
   require(finite(s.air.velocity), "wind velocity must be finite");
   require(finite(s.air.drag) && s.air.drag >= 0.0, "wind drag must be finite and >= 0");

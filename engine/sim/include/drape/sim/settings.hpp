@@ -73,6 +73,21 @@ struct SolverSettings {
   Real stretchTolerance = 0.04;
 };
 
+// Which solver keys go together, said once, for the scene reader, the panels, a change of model
+// and the world (which refuses settings that break it): the force model has none of xpbd, tethers,
+// lines, geometricStiffness, tethersBetweenSteps and extraLineSteps (they belong to the position
+// model) and the position model only the "verlet" integrator; geometricStiffness and
+// extraLineSteps need lines, tethersBetweenSteps lines and tethers.
+struct SolverConflict {
+  std::string_view key;    // the key that does not go with the others, as scene files spell it
+  std::string_view value;  // what it must be, and why: false unless "lines" is true (...)
+};
+// The first key that does not go with the others, in the order above; none if they all do.
+std::optional<SolverConflict> conflict(const SolverSettings& solver);
+// The settings with every key that does not go with the others turned off (an integrator, back to
+// "verlet" in the position model).
+SolverSettings consistent(SolverSettings solver);
+
 // The air around the cloth, moving uniformly at `velocity`.
 struct AirSettings {
   Vec3 velocity{0.0};   // m/s, the wind
