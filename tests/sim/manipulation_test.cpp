@@ -127,8 +127,8 @@ TEST(Finger, ReleasedParticlesKeepTheFingersVelocityInTheForceModelToo) {
 
 TEST(Finger, AParticleUnderTwoFingersBelongsToTheFirst) {
   World world(flatSheet(11));
-  const int first = world.pressFinger(1, Vec3{0.4, 0.0, 0.5}, 0.15);
-  const int second = world.pressFinger(2, Vec3{0.6, 0.0, 0.5}, 0.15);
+  const int first = world.pressFinger(1, Vec3{0.4, 0.0, 0.5}, 0.15).value();
+  const int second = world.pressFinger(2, Vec3{0.6, 0.0, 0.5}, 0.15).value();
   EXPECT_EQ(first, 9);
   EXPECT_EQ(second, 6);  // the column at x = 0.5 went to finger 1
   std::vector<ParticleIndex> a = held(world, 1), b = held(world, 2);
@@ -137,9 +137,32 @@ TEST(Finger, AParticleUnderTwoFingersBelongsToTheFirst) {
   std::vector<ParticleIndex> both;
   std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(both));
   EXPECT_TRUE(both.empty());
-  EXPECT_EQ(world.pressFinger(1, Vec3{0.0}, 0.1), -1);  // already down
-  EXPECT_FALSE(world.moveFinger(3, Vec3{0.0}));         // never down
+  EXPECT_FALSE(world.pressFinger(1, Vec3{0.0}, 0.1).has_value());  // already down
+  EXPECT_FALSE(world.moveFinger(3, Vec3{0.0}));                    // never down
   EXPECT_FALSE(world.releaseFinger(3));
+}
+
+// A finger call that cannot be done changes nothing and says so one way: nothing back (nullopt, or
+// false), never a throw, never a number that means failure.
+TEST(Finger, EveryCallThatCannotBeDoneReturnsNothingAndChangesNothing) {
+  World world(flatSheet(11));
+  const std::vector<Vec3> before = world.cloths()[0].state.position;
+  const Real nan = std::nan("");
+  EXPECT_FALSE(world.moveFinger(5, Vec3{0.0}));  // not down
+  EXPECT_FALSE(world.releaseFinger(5));
+  EXPECT_FALSE(world.pinFinger(5).has_value());
+  EXPECT_FALSE(world.pressFinger(5, Vec3{nan, 0.0, 0.0}, 0.1).has_value());  // numbers not finite
+  EXPECT_FALSE(world.pressFinger(5, Vec3{0.0}, -0.1).has_value());
+  EXPECT_FALSE(world.pressFingerAlongRay(5, Vec3{0.5, 1.0, 0.5}, Vec3{0.0, nan, 0.0}, 0.1).has_value());
+  EXPECT_EQ(world.unpin(Vec3{nan, 0.0, 0.0}, 0.1), 0);
+  EXPECT_TRUE(world.fingers().empty());
+  ASSERT_TRUE(world.pressFinger(5, Vec3{0.5, 0.0, 0.5}, 0.05).has_value());
+  EXPECT_FALSE(world.moveFinger(5, Vec3{nan, 0.0, 0.0}));
+  EXPECT_FALSE(world.pressFinger(5, Vec3{0.5, 0.0, 0.5}, 0.05).has_value());  // down already
+  for (int id = 100; id < 100 + kMaxFingers - 1; ++id) ASSERT_TRUE(world.pressFinger(id, Vec3{9.0}, 0.01));
+  EXPECT_FALSE(world.pressFinger(1000, Vec3{0.5, 0.0, 0.5}, 0.05).has_value());  // too many down
+  EXPECT_EQ(world.fingers().size(), static_cast<std::size_t>(kMaxFingers));
+  EXPECT_EQ(world.cloths()[0].state.position, before);
 }
 
 TEST(Finger, PressAlongARayTakesTheFirstClothItMeets) {

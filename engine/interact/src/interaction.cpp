@@ -146,8 +146,7 @@ bool Interaction::down(int id, const Pointer& pointer, std::optional<Real> radiu
     std::optional<Vec3> pressed;
     if (pointer.kind == Pointer::Kind::world) {
       if (!finite(pointer.world)) return fail("finger " + std::to_string(id) + ": the point is not finite");
-      if (world_.pressFinger(id, pointer.world, r) < 0)
-        return fail("finger " + std::to_string(id) + " is already down");
+      if (!world_.pressFinger(id, pointer.world, r)) return fail("finger " + std::to_string(id) + " is already down");
       pressed = pointer.world;
     } else {
       if (!std::isfinite(pointer.screen.x) || !std::isfinite(pointer.screen.y)) {

@@ -770,10 +770,10 @@ void World::grab(Finger& finger, std::size_t c, ParticleIndex nearest) {
   }
 }
 
-int World::pressFinger(int id, Vec3 point, Real radius) {
+std::optional<int> World::pressFinger(int id, Vec3 point, Real radius) {
   if (finger(id) || fingers_.size() >= static_cast<std::size_t>(kMaxFingers) || !finite(point) || !finite(radius) ||
       !(radius > 0.0)) {
-    return -1;
+    return std::nullopt;
   }
   Finger f;
   f.id = id;
@@ -848,9 +848,9 @@ bool World::releaseFinger(int id) {
   return true;
 }
 
-int World::pinFinger(int id) {
+std::optional<int> World::pinFinger(int id) {
   Finger* f = findFinger(id);
-  if (!f) return -1;
+  if (!f) return std::nullopt;
   std::vector<std::size_t> changed;
   for (const FingerGrip& grip : f->grips) {
     const auto c = static_cast<std::size_t>(grip.cloth);

@@ -156,12 +156,15 @@ class World {
   // quite stable undamped). Infinity in the position model or without springs.
   Real stableForceSubstep() const;
 
-  // Fingers. Up to kMaxFingers may be down at once, each under the caller's id.
+  // Fingers. Up to kMaxFingers may be down at once, each under the caller's id. A finger call that
+  // cannot be done (an id not down, or down already; too many fingers; numbers not finite) changes
+  // nothing and says so the same way every time: it returns nothing (std::nullopt, or false where
+  // there is nothing else to return). None throws.
   // press: every particle within `radius` of `point` on the piece of the particle nearest to it
   // sticks to the finger, except particles another finger already holds (the first finger keeps
-  // them). Returns how many it holds (a finger that touches nothing is still down), or -1 if the id
-  // is already down, kMaxFingers are down, or the numbers are not finite and positive.
-  int pressFinger(int id, Vec3 point, Real radius);
+  // them). Returns how many it holds (a finger that touches nothing is still down), or nothing if
+  // the id is already down, kMaxFingers are down, or the numbers are not finite and positive.
+  std::optional<int> pressFinger(int id, Vec3 point, Real radius);
   // As press, at the point of the ray (origin + t direction, t > 0) nearest to the first particle
   // the ray passes within `radius` of. Returns that point, or nothing if the ray meets no cloth (the
   // finger is then not down).
@@ -172,10 +175,11 @@ class World {
   // Lets go: the particles fly on with the finger's last velocity (a flick throws the cloth).
   bool releaseFinger(int id);
   // Lifts the finger but leaves what it held pinned where it is. Returns how many particles were
-  // pinned, or -1 if the id is not down. No tethers go to these pins (Cloth::tetherPins); the
+  // pinned, or nothing if the id is not down. No tethers go to these pins (Cloth::tetherPins); the
   // pinned particles lose their own.
-  int pinFinger(int id);
-  // Frees the pinned particles within `radius` of `point` (not those a finger holds). Returns how many.
+  std::optional<int> pinFinger(int id);
+  // Frees the pinned particles within `radius` of `point` (not those a finger holds). Returns how
+  // many (none where there are none, or the numbers are not finite).
   int unpin(Vec3 point, Real radius);
   const std::vector<Finger>& fingers() const { return fingers_; }
   const Finger* finger(int id) const;
