@@ -182,7 +182,7 @@ int fabric(const FabricArguments& arguments) {
            << within << " of " << runs << " runs are within 5 %.\n\n"
            << "## Reading it\n\n"
            << "- **Bending is solved at once.** Each sweep projects all of a cloth's bend stencils together,\n"
-           << "  one banded Cholesky solve of their XPBD block (engine/sim/src/bending.hpp), so a moment reaches\n"
+           << "  one banded Cholesky solve of their XPBD block (engine/sim/src/solver/bending.hpp), so a moment reaches\n"
            << "  the whole strip in one sweep. Swept one stencil after another instead, as before, a 3.125 mm\n"
            << "  strip at 10 x 16 with lines sat 6 to 41 % soft, and warm-starting the stencils' multipliers\n"
            << "  from the last substep (tried) kept fine strips oscillating at 2 sweeps.\n"

@@ -1,6 +1,6 @@
 #include "drape/sim/state.hpp"
 
-#include "solver_scratch.hpp"
+#include "solver/solver_scratch.hpp"
 
 #include <limits>
 #include <stdexcept>

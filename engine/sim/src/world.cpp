@@ -15,16 +15,16 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
-#include "batches.hpp"
-#include "contacts.hpp"
-#include "force_model.hpp"
-#include "lines.hpp"
-#include "position_model.hpp"
-#include "self_contact.hpp"
-#include "solver_scratch.hpp"
-#include "tethers.hpp"
-#include "topology.hpp"
-#include "workers.hpp"
+#include "solver/batches.hpp"
+#include "collision/contacts.hpp"
+#include "solver/force_model.hpp"
+#include "solver/lines.hpp"
+#include "solver/position_model.hpp"
+#include "collision/self_contact.hpp"
+#include "solver/solver_scratch.hpp"
+#include "solver/tethers.hpp"
+#include "topology/topology.hpp"
+#include "parallel/workers.hpp"
 
 namespace drape::sim {
 

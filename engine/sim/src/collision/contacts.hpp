@@ -1,0 +1,42 @@
+// Contacts between particles and colliders, and self-collision between particles of a cloth.
+//
+// Each substep, `detect` finds for every free particle the collider surface its motion from
+// x_prev to x comes within `thickness` of: by sphere tracing the signed distance along that
+// segment, so a fast particle meets a thin collider instead of tunnelling through it. The contact
+// is kept as a plane (n . x >= offset) that constraint projection re-enforces after every sweep,
+// so constraints and contacts agree. `friction` then applies Coulomb friction in position form.
+#pragma once
+
+#include <vector>
+
+#include "drape/sim/collider.hpp"
+#include "drape/sim/settings.hpp"
+#include "drape/sim/state.hpp"
+#include "drape/sim/world.hpp"
+#include "solver/solver_scratch.hpp"
+#include "parallel/workers.hpp"
+
+namespace drape::sim::contact {
+
+void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch& scratch);
+void project(Cloth& cloth, SolverScratch& scratch);
+// Static while the tangential motion relative to the surface is below mu_s times the penetration
+// resolved this substep (by the first projection and by every re-projection after a sweep), else reduced by mu_k times
+// it: on a slope a particle sticks when tan(theta) < mu_s and slides with a = g (sin(theta) - mu_k cos(theta))
+// otherwise.
+void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, const SolverScratch& scratch);
+// Force model: project onto the contact planes, remove the normal velocity into the surface, and
+// reduce the tangential velocity by Coulomb friction with the impulse that took.
+void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch);
+
+// Self-collision: no particle within `distance` of another (or of their rest distance, if that is
+// smaller), found with a spatial hash; their relative tangential motion damped by `friction`.
+// clampTravel runs at the end of a substep and caps the velocity carried into the next one (by
+// moving x_prev, not x, so it never undoes what the constraints just did): no particle then
+// travels more than maxTravel in a substep on its own momentum, too little to pass through a layer.
+void clampTravel(Cloth& cloth, Real maxTravel);
+// Works across all cloths of the world, so two cloths collide with each other too.
+void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
+                 Workers& workers);
+
+}  // namespace drape::sim::contact

@@ -1,0 +1,1313 @@
+#include "collision/self_contact.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "collision/exact_triangles.hpp"
+
+namespace drape::sim::contact {
+
+namespace {
+
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+// Sweeps of the contacts a substep: each pair is pushed out in the first; the rest settle pairs
+// that push each other (a particle between two layers).
+constexpr int kSweeps = 4;
+// Room left for rounding where the fail-safe proves two primitives apart, m: far above the error of
+// the distances (1e-12 m), above the exact test's grid (6e-8 m).
+constexpr Real kProofMargin = 1e-6;
+// A fold between neighbours whose signed volume at x0 is under this times the product of the lengths
+// of its three edges from a shared corner (about the sine of its angle) lies flat: which side its
+// free corner was on is rounding, and no side it goes to passes it through. A crumple closes
+// creases flat: without this, the spread gesture zoned 2,759 such folds and ended 5.5 cm high.
+constexpr Real kFlatFold = 1e-3;
+// Two points closer than this at x0 give no direction to keep apart along.
+constexpr Real kCoincident = 1e-12;
+// A pair whose free corners would each move more than 1 / kLeverage times as far as its points part
+// pushes nothing: a free corner of weight 0.004 in a triangle whose other corners and the vertex
+// fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair apart instead.
+constexpr Real kLeverage = 0.25;
+// How many times its rest size a triangle or edge may be stretched and still take part (longer
+// than its cloth at rest too, it takes none: findPairs).
+constexpr Real kTorn = 10.0;
+
+// Where more than one particle in this many leaves its box in the fail-safe, the pairs are found
+// again by a search; fewer, by pairing again what their primitives' boxes overlap (a refresh).
+constexpr std::size_t kStraysForSearch = 8;
+// Triangles a leaf of the broad phase's tree holds at most.
+constexpr std::size_t kLeafTriangles = 2;
+// Pairs of leaves a thread takes at a time when it lists their primitives' pairs.
+constexpr std::size_t kLeafPairBlock = 256;
+
+// Closest point of triangle abc to p, as barycentric weights of a, b, c (by the triangle's Voronoi
+// regions: a corner, an edge, or the inside).
+Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const Real d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};
+  const Vec3 bp = p - b;
+  const Real d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return {0.0, 1.0, 0.0};
+  const Real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0) {
+    const Real t = d1 / (d1 - d3);
+    return {1.0 - t, t, 0.0};
+  }
+  const Vec3 cp = p - c;
+  const Real d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return {0.0, 0.0, 1.0};
+  const Real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0) {
+    const Real t = d2 / (d2 - d6);
+    return {1.0 - t, 0.0, t};
+  }
+  const Real va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 && (d4 - d3) + (d5 - d6) > 0.0) {
+    const Real t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0.0, 1.0 - t, t};
+  }
+  const Real sum = va + vb + vc;
+  if (!(sum > 0.0)) {
+    // No area: the nearest corner will do.
+    const Real da = glm::dot(ap, ap), db = glm::dot(bp, bp), dc = glm::dot(cp, cp);
+    return da <= db && da <= dc ? Vec3{1.0, 0.0, 0.0} : db <= dc ? Vec3{0.0, 1.0, 0.0} : Vec3{0.0, 0.0, 1.0};
+  }
+  const Real v = vb / sum, w = vc / sum;
+  return {1.0 - v - w, v, w};
+}
+
+// Closest points of segments p1q1 and p2q2: p1 + s (q1 - p1) and p2 + t (q2 - p2).
+std::pair<Real, Real> closestOnSegments(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2) {
+  const Vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+  const Real a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+  constexpr Real tiny = 1e-30;
+  if (a <= tiny && e <= tiny) return {0.0, 0.0};
+  if (a <= tiny) return {0.0, std::clamp(f / e, 0.0, 1.0)};
+  const Real c = glm::dot(d1, r);
+  if (e <= tiny) return {std::clamp(-c / a, 0.0, 1.0), 0.0};
+  const Real b = glm::dot(d1, d2);
+  const Real denominator = a * e - b * b;
+  Real s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+  Real t = (b * s + f) / e;
+  if (t < 0.0) {
+    t = 0.0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (t > 1.0) {
+    t = 1.0;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+  return {s, t};
+}
+
+struct Weights {
+  Real c[4];
+};
+
+Weights vertexTriangleWeights(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 bary = closestOnTriangle(p, a, b, c);
+  return {{1.0, -bary.x, -bary.y, -bary.z}};
+}
+
+Weights edgeEdgeWeights(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1) {
+  const auto [s, t] = closestOnSegments(a0, a1, b0, b1);
+  return {{1.0 - s, s, -(1.0 - t), -t}};
+}
+
+// sum_k c_k x_k: the first point minus the second.
+Vec3 between(const Weights& w, const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
+  return p0 * w.c[0] + p1 * w.c[1] + p2 * w.c[2] + p3 * w.c[3];
+}
+
+// A box in single precision, grown to hold the double one.
+// (Clamped to the float range first: a torn primitive's empty box is +-DBL_MAX, which no float
+// holds, and converting it would be undefined. A NaN stays NaN.)
+float toFloat(Real v) {
+  constexpr Real most = std::numeric_limits<float>::max();
+  return static_cast<float>(v < -most ? -most : v > most ? most : v);
+}
+glm::vec3 below(const Vec3& x) {
+  return {std::nextafter(toFloat(x.x), -INFINITY), std::nextafter(toFloat(x.y), -INFINITY),
+          std::nextafter(toFloat(x.z), -INFINITY)};
+}
+glm::vec3 above(const Vec3& x) {
+  return {std::nextafter(toFloat(x.x), INFINITY), std::nextafter(toFloat(x.y), INFINITY),
+          std::nextafter(toFloat(x.z), INFINITY)};
+}
+
+bool overlap(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& otherLo, const glm::vec3& otherHi) {
+  return lo.x <= otherHi.x && otherLo.x <= hi.x && lo.y <= otherHi.y && otherLo.y <= hi.y && lo.z <= otherHi.z &&
+         otherLo.z <= hi.z;
+}
+
+}  // namespace
+
+std::size_t SelfContact::bytes() const {
+  const auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  std::size_t total = b(clothOf_) + b(rest_) + b(clothSize_) + b(triangles_) + b(edges_) + b(edgeTriangles_) +
+                      b(vertexStart_) + b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) +
+                      b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
+                      b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) +
+                      b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) +
+                      b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_);
+  total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
+           b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
+  for (const std::vector<Pair>& found : found_) total += b(found);
+  for (const std::vector<Contact>& measured : measured_) total += b(measured);
+  return total;
+}
+
+void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
+  clothOf_.clear();
+  rest_.clear();
+  clothSize_.clear();
+  triangles_.clear();
+  for (std::size_t c = 0; c < cloths.size(); ++c) {
+    const auto base = static_cast<std::uint32_t>(clothOf_.size());
+    const Cloth& cloth = cloths[c];
+    // The cloth's size at rest: the diagonal of its rest shape's box, squared (0 with no particle).
+    Vec3 lo(std::numeric_limits<Real>::max()), hi(std::numeric_limits<Real>::lowest());
+    for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
+      clothOf_.push_back(static_cast<std::uint32_t>(c));
+      rest_.push_back(cloth.rest.restPosition(i));
+      lo = glm::min(lo, rest_.back());
+      hi = glm::max(hi, rest_.back());
+    }
+    clothSize_.push_back(lo.x <= hi.x ? glm::dot(hi - lo, hi - lo) : 0.0);
+    for (const glm::uvec3& t : cloth.rest.triangles) triangles_.push_back(t + base);
+  }
+  const std::size_t n = clothOf_.size();
+  // Edges: each once, with the (one or two) triangles on it.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> sides;
+  sides.reserve(triangles_.size() * 3);
+  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = triangles_[t][k], b = triangles_[t][(k + 1) % 3];
+      sides.push_back({(static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b), t});
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  edges_.clear();
+  edgeTriangles_.clear();
+  for (std::size_t i = 0; i < sides.size();) {
+    std::size_t j = i;
+    while (j < sides.size() && sides[j].first == sides[i].first) ++j;
+    edges_.push_back({static_cast<std::uint32_t>(sides[i].first >> 32), static_cast<std::uint32_t>(sides[i].first)});
+    edgeTriangles_.push_back(sides[i].second);
+    edgeTriangles_.push_back(j - i > 1 ? sides[i + 1].second : kNone);
+    i = j;
+  }
+  vertexStart_.assign(n + 1, 0);
+  for (const glm::uvec3& t : triangles_) {
+    for (int k = 0; k < 3; ++k) ++vertexStart_[t[k] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) vertexStart_[i + 1] += vertexStart_[i];
+  vertexTriangles_.resize(vertexStart_[n]);
+  std::vector<std::uint32_t> fill(vertexStart_.begin(), vertexStart_.end() - 1);
+  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+    for (int k = 0; k < 3; ++k) vertexTriangles_[fill[triangles_[t][k]]++] = t;
+  }
+  meshParticles_ = n;
+  buildTree();
+}
+
+void SelfContact::buildTree() {
+  const std::size_t n = clothOf_.size(), nt = triangles_.size();
+  // The items the tree splits: the triangles (ids 0 .. nt - 1), then the particles in no triangle
+  // (nt + the particle), each at its rest centroid; cloth by cloth.
+  std::vector<std::uint32_t> items;
+  std::vector<Vec3> centre(nt + n);
+  std::vector<std::uint32_t> cloth(nt + n);
+  for (std::uint32_t t = 0; t < nt; ++t) {
+    const glm::uvec3 v = triangles_[t];
+    items.push_back(t);
+    centre[t] = (rest_[v[0]] + rest_[v[1]] + rest_[v[2]]) / 3.0;
+    cloth[t] = clothOf_[v[0]];
+  }
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (vertexStart_[v] != vertexStart_[v + 1]) continue;
+    const auto id = static_cast<std::uint32_t>(nt + v);
+    items.push_back(id);
+    centre[id] = rest_[v];
+    cloth[id] = clothOf_[v];
+  }
+  std::stable_sort(items.begin(), items.end(), [&](std::uint32_t a, std::uint32_t b) { return cloth[a] < cloth[b]; });
+
+  nodes_.clear();
+  leafNode_.clear();
+  leafTriangles_.clear();
+  leafTriangleStart_.assign(1, 0);
+  std::vector<std::uint32_t> leafOfItem(nt + n, kNone);
+  const auto build = [&](auto&& self, std::size_t begin, std::size_t end) -> std::uint32_t {
+    const auto node = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.push_back({});
+    if (end - begin <= kLeafTriangles) {
+      const auto leaf = static_cast<std::uint32_t>(leafNode_.size());
+      leafNode_.push_back(node);
+      nodes_[node].left = leaf;
+      nodes_[node].right = kNone;
+      for (std::size_t i = begin; i < end; ++i) {
+        leafOfItem[items[i]] = leaf;
+        if (items[i] < nt) leafTriangles_.push_back(items[i]);
+      }
+      leafTriangleStart_.push_back(static_cast<std::uint32_t>(leafTriangles_.size()));
+      return node;
+    }
+    std::size_t middle = begin + (end - begin) / 2;
+    if (cloth[items[begin]] != cloth[items[end - 1]]) {
+      // Cloths apart: at the border between two cloths nearest the middle.
+      const std::uint32_t c = cloth[items[middle]];
+      const auto byCloth = [&](std::uint32_t item, std::uint32_t value) { return cloth[item] < value; };
+      const auto from = static_cast<std::size_t>(
+          std::lower_bound(items.begin() + begin, items.begin() + end, c, byCloth) - items.begin());
+      const auto to = static_cast<std::size_t>(
+          std::lower_bound(items.begin() + begin, items.begin() + end, c + 1, byCloth) - items.begin());
+      middle = from > begin && (to >= end || middle - from <= to - middle) ? from : to;
+    } else {
+      // Halved at the median along the longest side of the centroids' box.
+      Vec3 lo(std::numeric_limits<Real>::max()), hi(std::numeric_limits<Real>::lowest());
+      for (std::size_t i = begin; i < end; ++i) {
+        lo = glm::min(lo, centre[items[i]]);
+        hi = glm::max(hi, centre[items[i]]);
+      }
+      const Vec3 size = hi - lo;
+      const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+      std::nth_element(items.begin() + begin, items.begin() + middle, items.begin() + end,
+                       [&](std::uint32_t a, std::uint32_t b) {
+                         return centre[a][axis] < centre[b][axis] || (centre[a][axis] == centre[b][axis] && a < b);
+                       });
+    }
+    const std::uint32_t left = self(self, begin, middle);
+    const std::uint32_t right = self(self, middle, end);
+    nodes_[node].left = left;
+    nodes_[node].right = right;
+    return node;
+  };
+  if (!items.empty()) build(build, 0, items.size());
+
+  // Vertices and edges go to the leaf of their first triangle.
+  const std::size_t leaves = leafNode_.size();
+  const auto group = [&](std::vector<std::uint32_t>& start, std::vector<std::uint32_t>& members, std::size_t count,
+                         auto&& leafOf) {
+    start.assign(leaves + 1, 0);
+    for (std::size_t i = 0; i < count; ++i) ++start[leafOf(i) + 1];
+    for (std::size_t l = 0; l < leaves; ++l) start[l + 1] += start[l];
+    members.resize(count);
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < count; ++i) members[fill[leafOf(i)]++] = static_cast<std::uint32_t>(i);
+  };
+  group(leafVertexStart_, leafVertices_, n, [&](std::size_t v) {
+    return vertexStart_[v] != vertexStart_[v + 1] ? leafOfItem[vertexTriangles_[vertexStart_[v]]] : leafOfItem[nt + v];
+  });
+  group(leafEdgeStart_, leafEdges_, edges_.size(), [&](std::size_t e) { return leafOfItem[edgeTriangles_[2 * e]]; });
+}
+
+void SelfContact::fitTree() {
+  const std::size_t n = x_.size(), nt = triangles_.size();
+  const glm::vec3 none(std::numeric_limits<float>::max());
+  for (std::size_t l = 0; l < leafNode_.size(); ++l) {
+    glm::vec3 lo = none, hi = -none;
+    const auto add = [&](std::size_t box) {
+      lo = glm::min(lo, boxLower_[box]);
+      hi = glm::max(hi, boxUpper_[box]);
+    };
+    for (std::uint32_t k = leafVertexStart_[l]; k < leafVertexStart_[l + 1]; ++k) add(leafVertices_[k]);
+    for (std::uint32_t k = leafTriangleStart_[l]; k < leafTriangleStart_[l + 1]; ++k) add(n + leafTriangles_[k]);
+    for (std::uint32_t k = leafEdgeStart_[l]; k < leafEdgeStart_[l + 1]; ++k) add(n + nt + leafEdges_[k]);
+    nodes_[leafNode_[l]].lower = lo;
+    nodes_[leafNode_[l]].upper = hi;
+  }
+  for (std::size_t i = nodes_.size(); i-- > 0;) {
+    Node& node = nodes_[i];
+    if (node.right == kNone) continue;
+    node.lower = glm::min(nodes_[node.left].lower, nodes_[node.right].lower);
+    node.upper = glm::max(nodes_[node.left].upper, nodes_[node.right].upper);
+  }
+}
+
+void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>* scratch,
+                         const std::vector<std::vector<Vec3>>* before) {
+  const std::size_t n = clothOf_.size();
+  x0_.resize(n);
+  x_.resize(n);
+  w_.resize(n);
+  planes_.clear();
+  std::size_t k = 0;
+  for (std::size_t c = 0; c < cloths.size(); ++c) {
+    const ParticleState& s = cloths[c].state;
+    const bool planes = scratch && (*scratch)[c].contactCollider.size() == s.position.size();
+    for (std::size_t i = 0; i < s.position.size(); ++i, ++k) {
+      // Where the substep began (the integration left it there), or where the move began.
+      x0_[k] = before ? (*before)[c][i] : s.previousPosition[i];
+      x_[k] = s.position[i];
+      w_[k] = s.inverseMass[i];
+      if (planes && (*scratch)[c].contactCollider[i] >= 0) {
+        const SolverScratch& contacts = (*scratch)[c];
+        planes_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(i),
+                           contacts.contactNormal[i], contacts.contactOffset[i]});
+      }
+    }
+  }
+}
+
+// A triangle or edge stretched past kTorn times its rest size and longer than its whole cloth at
+// rest is no cloth any more (a finger flung its patch 100 m): it takes no part, or its box would
+// pair it with everything in between. (Not by its rest size alone: on a fine lattice, where a twist
+// winds the cloth round a grip, self-contact holds some of the grip's particles back while the
+// rest move on, the links between them stretch ten times over within a few centimetres, and
+// those triangles passed through the layers.)
+bool SelfContact::torn(const std::uint32_t* v, int count) const {
+  const auto longest = [&](const std::vector<Vec3>& x) {
+    Real most = 0.0;
+    for (int i = 0; i < count; ++i) {
+      const Vec3 d = x[v[i]] - x[v[(i + 1) % count]];
+      most = std::max(most, glm::dot(d, d));
+    }
+    return most;
+  };
+  return longest(x_) > std::max(kTorn * kTorn * longest(rest_), clothSize_[clothOf_[v[0]]]) + 4.0 * grow_ * grow_;
+}
+
+void SelfContact::boxPrimitive(std::size_t k) {
+  const std::size_t n = x_.size(), nt = triangles_.size();
+  const bool triangle = k < n + nt;
+  const std::uint32_t* v = triangle ? &triangles_[k - n][0] : &edges_[k - n - nt][0];
+  const int count = triangle ? 3 : 2;
+  if (torn(v, count)) {
+    lower_[k] = Vec3(std::numeric_limits<Real>::max());
+    upper_[k] = Vec3(std::numeric_limits<Real>::lowest());
+  } else {
+    lower_[k] = lower_[v[0]];
+    upper_[k] = upper_[v[0]];
+    for (int i = 1; i < count; ++i) {
+      lower_[k] = glm::min(lower_[k], lower_[v[i]]);
+      upper_[k] = glm::max(upper_[k], upper_[v[i]]);
+    }
+  }
+  // As the tree keeps it: single precision, rounded outwards.
+  boxLower_[k] = below(lower_[k]);
+  boxUpper_[k] = above(upper_[k]);
+}
+
+// Whether the two primitives' boxes lie apart along `axis` (the line between their centres): the
+// hull of the first `split` corners' boxes and that of the rest. Boxes that overlap
+// may still: a vertex's box inside a tilted triangle's box, a layer above it. Then, as for boxes
+// that do not overlap, while every particle keeps half a `distance` inside its box the two stay
+// at least `distance` apart (each hull shrinks by half a distance along the axis); so the pair is
+// not listed. Only where they are apart beyond rounding: the margin grows with the coordinates.
+bool SelfContact::apartBoxes(const std::uint32_t* corners, int split, Vec3 axis) const {
+  const Real length = glm::length(axis);
+  if (!(length > 0.0)) return false;
+  axis /= length;
+  const Vec3 size = glm::abs(axis);
+  Real lo[2] = {std::numeric_limits<Real>::max(), std::numeric_limits<Real>::max()};
+  Real hi[2] = {std::numeric_limits<Real>::lowest(), std::numeric_limits<Real>::lowest()};
+  Real scale = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 centre = (lower_[corners[k]] + upper_[corners[k]]) * 0.5;
+    const Real half = glm::dot(upper_[corners[k]] - lower_[corners[k]], size) * 0.5;
+    const Real at = glm::dot(centre, axis);
+    const int side = k < split ? 0 : 1;
+    lo[side] = std::min(lo[side], at - half);
+    hi[side] = std::max(hi[side], at + half);
+    // The dot products' rounding grows with the coordinates themselves, not with the projection.
+    scale = std::max(scale, glm::dot(glm::abs(centre), size) + half);
+  }
+  const Real margin = 1e-9 + 1e-12 * scale;
+  // Not apart unless every figure is finite (min and max pass a NaN by).
+  if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + margin)) return false;
+  return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
+}
+
+void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
+  const std::size_t n = x_.size(), nt = triangles_.size(), ne = edges_.size();
+  // Boxes: each particle's motion, from x0 on for `ahead` times its motion in this substep (the
+  // substeps left in the step: the pairs then serve for all of them while the particles keep
+  // within), grown by `distance`, so that two boxes overlap wherever two primitives may come within
+  // twice that. The solve may push a particle up to `distance` beyond, before the pairs must be found
+  // again (SelfContact::strays).
+  const Real grow = distance;
+  lower_.resize(n + nt + ne);
+  upper_.resize(n + nt + ne);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 to = x0_[i] + (x_[i] - x0_[i]) * ahead;
+    lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
+    upper_[i] = glm::max(glm::max(x0_[i], x_[i]), to) + grow;
+  }
+  grow_ = grow;
+  boxLower_.resize(n + nt + ne);
+  boxUpper_.resize(n + nt + ne);
+  for (std::size_t i = 0; i < n; ++i) {
+    boxLower_[i] = below(lower_[i]);
+    boxUpper_[i] = above(upper_[i]);
+  }
+  for (std::size_t k = n; k < n + nt + ne; ++k) boxPrimitive(k);
+  fitTree();
+  ++stats_.searches;
+
+  // The pairs of leaves whose boxes overlap, each once (a leaf with itself too), in the walk's order.
+  const auto both = [](std::uint32_t a, std::uint32_t b) { return (static_cast<std::uint64_t>(a) << 32) | b; };
+  const auto isLeaf = [&](const Node& node) { return node.right == kNone; };
+  const auto extent = [](const Node& node) {
+    const glm::vec3 size = node.upper - node.lower;
+    return size.x + size.y + size.z;
+  };
+  std::int64_t tests = 0;
+  leafPairs_.clear();
+  stack_.clear();
+  if (!nodes_.empty()) stack_.push_back(both(0, 0));
+  while (!stack_.empty()) {
+    const auto a = static_cast<std::uint32_t>(stack_.back() >> 32), b = static_cast<std::uint32_t>(stack_.back());
+    stack_.pop_back();
+    const Node& p = nodes_[a];
+    const Node& q = nodes_[b];
+    if (a == b) {
+      if (isLeaf(p)) {
+        leafPairs_.push_back(both(p.left, p.left));
+      } else {
+        // Last in, first out: the left half, the right half, then the two against each other.
+        stack_.push_back(both(p.left, p.right));
+        stack_.push_back(both(p.right, p.right));
+        stack_.push_back(both(p.left, p.left));
+      }
+      continue;
+    }
+    ++tests;
+    if (!overlap(p.lower, p.upper, q.lower, q.upper)) continue;
+    if (isLeaf(p) && isLeaf(q)) {
+      leafPairs_.push_back(both(std::min(p.left, q.left), std::max(p.left, q.left)));
+    } else if (!isLeaf(p) && (isLeaf(q) || extent(p) >= extent(q))) {
+      stack_.push_back(both(p.right, b));
+      stack_.push_back(both(p.left, b));
+    } else {
+      stack_.push_back(both(a, q.right));
+      stack_.push_back(both(a, q.left));
+    }
+  }
+
+  const auto apart = [&](const std::uint32_t* corners, int split, Vec3 axis) {
+    return apartBoxes(corners, split, axis);
+  };
+
+  // Their primitives, in parallel: blocks of leaf pairs to whichever thread is free (a crumpled
+  // pile's leaves find far more than a flat sheet's: in even runs, one thread had most of the work
+  // and two threads were no faster than one), each block's pairs in its own lists, joined in the
+  // blocks' order, so the same whatever the number of threads.
+  const auto threads = static_cast<std::size_t>(workers.threads());
+  const std::size_t blocks = (leafPairs_.size() + kLeafPairBlock - 1) / kLeafPairBlock;
+  found_.resize(2 * blocks);
+  boxTests_.assign(threads, 0);
+  for (std::vector<Pair>& found : found_) found.clear();
+  workers.runShared(
+      leafPairs_.size(), kLeafPairBlock,
+      [&](std::size_t begin, std::size_t end, int thread) {
+        // The block's lists and count on this thread's stack while it fills them: the lists' headers
+        // and the counts of two threads share cache lines, and writing them at every pair and every
+        // test made two threads no faster than one.
+        const std::size_t block = begin / kLeafPairBlock;
+        std::vector<Pair> vertexTriangle, edgeEdge;
+        vertexTriangle.swap(found_[2 * block]);
+        edgeEdge.swap(found_[2 * block + 1]);
+        std::int64_t compared = 0;
+        // The vertices of leaf `from` against the triangles of leaf `to`: not those it is a corner of.
+        const auto vertices = [&](std::uint32_t from, std::uint32_t to) {
+          const Node& other = nodes_[leafNode_[to]];
+          for (std::uint32_t i = leafVertexStart_[from]; i < leafVertexStart_[from + 1]; ++i) {
+            const std::uint32_t v = leafVertices_[i];
+            const glm::vec3 lo = boxLower_[v], hi = boxUpper_[v];
+            ++compared;
+            if (from != to && !overlap(lo, hi, other.lower, other.upper)) continue;
+            for (std::uint32_t j = leafTriangleStart_[to]; j < leafTriangleStart_[to + 1]; ++j) {
+              const std::uint32_t t = leafTriangles_[j];
+              ++compared;
+              if (!overlap(lo, hi, boxLower_[n + t], boxUpper_[n + t])) continue;
+              const glm::uvec3 c = triangles_[t];
+              if (c[0] == v || c[1] == v || c[2] == v) continue;
+              const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
+              if (apart(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) continue;
+              vertexTriangle.push_back({v, t, kFar, false, false});
+            }
+          }
+        };
+        for (std::size_t i = begin; i < end; ++i) {
+          const auto l = static_cast<std::uint32_t>(leafPairs_[i] >> 32), m = static_cast<std::uint32_t>(leafPairs_[i]);
+          vertices(l, m);
+          if (l != m) vertices(m, l);
+          // Edge pairs that share no end, each once: within one leaf, the later against the earlier.
+          const Node& other = nodes_[leafNode_[m]];
+          for (std::uint32_t i0 = leafEdgeStart_[l]; i0 < leafEdgeStart_[l + 1]; ++i0) {
+            const std::uint32_t e = leafEdges_[i0];
+            const glm::vec3 lo = boxLower_[n + nt + e], hi = boxUpper_[n + nt + e];
+            ++compared;
+            if (l != m && !overlap(lo, hi, other.lower, other.upper)) continue;
+            for (std::uint32_t i1 = l == m ? i0 + 1 : leafEdgeStart_[m]; i1 < leafEdgeStart_[m + 1]; ++i1) {
+              const std::uint32_t f = leafEdges_[i1];
+              ++compared;
+              if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
+              const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
+              if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
+              const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
+              if (apart(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
+              edgeEdge.push_back({std::min(e, f), std::max(e, f), kFar, true, false});
+            }
+          }
+        }
+        found_[2 * block].swap(vertexTriangle);
+        found_[2 * block + 1].swap(edgeEdge);
+        boxTests_[static_cast<std::size_t>(thread)] += compared;
+      },
+      64);
+  pairs_.clear();
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (std::size_t b = 0; b < blocks; ++b)
+      pairs_.insert(pairs_.end(), found_[2 * b + k].begin(), found_[2 * b + k].end());
+  }
+  for (const std::int64_t compared : boxTests_) tests += compared;
+  stats_.boxTests += tests;
+}
+
+void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
+  // Each stray particle's box: its motion in this substep as it now is, grown as a search grows
+  // it. The triangles and edges it is a corner of are boxed again; every pair of these primitives
+  // goes, and each is paired anew with whatever its box overlaps, as a search would pair it. The
+  // other pairs a search would find are already listed: their boxes are as they were.
+  const std::size_t n = x_.size(), nt = triangles_.size(), ne = edges_.size();
+  ++stats_.refreshes;
+  affected_.assign(n + nt + ne, 0);
+  for (const std::uint32_t i : strays) {
+    affected_[i] = 1;
+    lower_[i] = glm::min(x0_[i], x_[i]) - grow_;
+    upper_[i] = glm::max(x0_[i], x_[i]) + grow_;
+    boxLower_[i] = below(lower_[i]);
+    boxUpper_[i] = above(upper_[i]);
+    for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) affected_[n + vertexTriangles_[k]] = 1;
+  }
+  for (std::size_t e = 0; e < ne; ++e) {
+    if (affected_[edges_[e][0]] || affected_[edges_[e][1]]) affected_[n + nt + e] = 1;
+  }
+  for (std::size_t k = n; k < n + nt + ne; ++k) {
+    if (affected_[k]) boxPrimitive(k);
+  }
+  std::erase_if(pairs_, [&](const Pair& p) {
+    return p.edges ? affected_[n + nt + p.first] || affected_[n + nt + p.second]
+                   : affected_[p.first] || affected_[n + p.second];
+  });
+  fitTree();
+
+  std::int64_t compared = 0;
+  // The leaves whose boxes overlap box k, in the tree's order.
+  const auto leaves = [&](std::size_t k, auto&& visit) {
+    walk_.clear();
+    if (!nodes_.empty()) walk_.push_back(0);
+    while (!walk_.empty()) {
+      const Node& node = nodes_[walk_.back()];
+      walk_.pop_back();
+      ++compared;
+      if (!overlap(node.lower, node.upper, boxLower_[k], boxUpper_[k])) continue;
+      if (node.right == kNone) {
+        visit(node.left);
+      } else {
+        walk_.push_back(node.right);
+        walk_.push_back(node.left);
+      }
+    }
+  };
+  // Listed as a search lists them, far (measured by the fail-safe if it must be), and marked new.
+  const auto vertexTriangle = [&](std::uint32_t v, std::uint32_t t) {
+    ++compared;
+    if (!overlap(boxLower_[v], boxUpper_[v], boxLower_[n + t], boxUpper_[n + t])) return;
+    const glm::uvec3 c = triangles_[t];
+    if (c[0] == v || c[1] == v || c[2] == v) return;
+    const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
+    if (apartBoxes(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) return;
+    pairs_.push_back({v, t, kFar, false, true});
+  };
+  // A stray vertex against every triangle; a triangle with a stray corner against every vertex
+  // but the stray ones (paired from their side); an edge with a stray end against every edge, and
+  // against another such edge once.
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (!affected_[v]) continue;
+    leaves(v, [&](std::uint32_t leaf) {
+      for (std::uint32_t j = leafTriangleStart_[leaf]; j < leafTriangleStart_[leaf + 1]; ++j)
+        vertexTriangle(v, leafTriangles_[j]);
+    });
+  }
+  for (std::uint32_t t = 0; t < nt; ++t) {
+    if (!affected_[n + t]) continue;
+    leaves(n + t, [&](std::uint32_t leaf) {
+      for (std::uint32_t j = leafVertexStart_[leaf]; j < leafVertexStart_[leaf + 1]; ++j) {
+        if (!affected_[leafVertices_[j]]) vertexTriangle(leafVertices_[j], t);
+      }
+    });
+  }
+  for (std::uint32_t e = 0; e < ne; ++e) {
+    if (!affected_[n + nt + e]) continue;
+    const glm::vec3 lo = boxLower_[n + nt + e], hi = boxUpper_[n + nt + e];
+    leaves(n + nt + e, [&](std::uint32_t leaf) {
+      for (std::uint32_t j = leafEdgeStart_[leaf]; j < leafEdgeStart_[leaf + 1]; ++j) {
+        const std::uint32_t f = leafEdges_[j];
+        if (f == e || (affected_[n + nt + f] && f < e)) continue;
+        ++compared;
+        if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
+        const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
+        if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
+        const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
+        if (apartBoxes(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
+        pairs_.push_back({std::min(e, f), std::max(e, f), kFar, true, true});
+      }
+    });
+  }
+  stats_.boxTests += compared;
+}
+
+const std::vector<std::uint32_t>& SelfContact::strays(const std::vector<std::uint32_t>* candidates, Real margin) {
+  strays_.clear();
+  const auto look = [&](std::uint32_t i) {
+    const Vec3 lo = lower_[i] + margin, hi = upper_[i] - margin;
+    for (const Vec3& x : {x0_[i], x_[i]}) {
+      if (glm::any(glm::lessThan(x, lo)) || glm::any(glm::greaterThan(x, hi))) {
+        strays_.push_back(i);
+        return;
+      }
+    }
+  };
+  if (candidates) {
+    for (const std::uint32_t i : *candidates) look(i);
+  } else {
+    for (std::uint32_t i = 0; i < x_.size(); ++i) look(i);
+  }
+  return strays_;
+}
+
+bool SelfContact::keepPairs(const std::vector<std::uint32_t>* candidates, Real distance, Workers& workers) {
+  if (strays(candidates, 0.0).empty()) return false;
+  if (strays_.size() * kStraysForSearch > x_.size()) {
+    findPairs(distance, 1.0, workers);
+    measurePairs(distance, workers);
+  } else {
+    refresh(strays_);
+  }
+  return true;
+}
+
+bool SelfContact::stillFar(const Pair& p) const {
+  const Real slack = 0.25 * (measuredDistance_ - kProofMargin);
+  if (!(slack > 0.0)) return false;
+  const std::array<std::uint32_t, 4> v = corners(p);
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 d = x_[v[k]] - xMeasured_[v[k]];
+    if (!(glm::dot(d, d) <= slack * slack)) return false;
+  }
+  return true;
+}
+
+bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
+  // Along the line between the two primitives' centres at x0: the hull of one's corners at x0 and
+  // at x against the other's. Apart there, they are apart all along the straight paths from x0 to
+  // x (each corner's path lies between its two ends), by more than `margin`.
+  const std::array<std::uint32_t, 4> v = corners(p);
+  const Vec3 axis = p.edges ? (x0_[v[0]] + x0_[v[1]]) * 0.5 - (x0_[v[2]] + x0_[v[3]]) * 0.5
+                            : x0_[v[0]] - (x0_[v[1]] + x0_[v[2]] + x0_[v[3]]) * (1.0 / 3.0);
+  const int split = p.edges ? 2 : 1;
+  Real lo[2], hi[2];
+  for (int side = 0; side < 2; ++side) {
+    lo[side] = std::numeric_limits<Real>::max();
+    hi[side] = std::numeric_limits<Real>::lowest();
+  }
+  for (int k = 0; k < 4; ++k) {
+    const int side = k < split ? 0 : 1;
+    const Real a = glm::dot(x0_[v[k]], axis), b = glm::dot(x_[v[k]], axis);
+    lo[side] = std::min({lo[side], a, b});
+    hi[side] = std::max({hi[side], a, b});
+  }
+  // Along the axis as it is (not of unit length): the margin scaled by its length, and room for
+  // the rounding of the dot products, which grows with the coordinates.
+  const Real length = glm::length(axis);
+  Real scale = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    scale =
+        std::max({scale, glm::dot(glm::abs(x0_[v[k]]), glm::abs(axis)), glm::dot(glm::abs(x_[v[k]]), glm::abs(axis))});
+  }
+  const Real room = margin * length + 1e-12 * scale;
+  // Not apart unless every figure is finite (min and max pass a NaN by).
+  if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + room)) return false;
+  return length > 0.0 && (hi[1] + room < lo[0] || hi[0] + room < lo[1]);
+}
+
+SelfContact::Contact SelfContact::measure(const Pair& pair, Real distance) const {
+  const std::array<std::uint32_t, 4> v = corners(pair);
+  Contact contact;
+  const Weights weights = pair.edges ? edgeEdgeWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]])
+                                     : vertexTriangleWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
+  for (int k = 0; k < 4; ++k) {
+    contact.c[k] = weights.c[k];
+    contact.v[k] = v[k];
+  }
+  contact.edges = pair.edges;
+  const Vec3 gap = between(weights, x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]]);
+  contact.gap0 = glm::length(gap);
+  contact.normal = contact.gap0 > kCoincident ? gap / contact.gap0 : Vec3{0.0};
+  contact.push = 0.0;
+  // How far apart the pair keeps: `distance`, or less for parts of one cloth closer than that at rest.
+  contact.target = distance;
+  if (clothOf_[v[0]] == clothOf_[v[2]]) {
+    const Weights rest = pair.edges ? edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])
+                                    : vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
+    contact.target = std::min(distance, glm::length(between(rest, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])));
+  }
+  return contact;
+}
+
+void SelfContact::measurePairs(Real distance, Workers& workers) {
+  // Each pair's closest points at x0, the direction between them, and how far apart they keep;
+  // except a pair apart by more than `distance` all through the substep (as the solve found it),
+  // which no sweep pushes: it is marked far, and the fail-safe looks at it again at its end.
+  // Each thread measures its run of the pairs into its own list, numbering them from 0; the lists
+  // are joined in order, and each thread then numbers its run's contacts from where its list went.
+  const auto threads = static_cast<std::size_t>(workers.threads());
+  measured_.resize(threads);
+  for (std::vector<Contact>& measured : measured_) measured.clear();
+  xMeasured_ = x_;
+  measuredDistance_ = distance;
+  auto measureRun = [&](std::size_t begin, std::size_t end, int thread) {
+    std::vector<Contact> measured;  // (on the thread's stack while it is filled, as in findPairs)
+    measured.swap(measured_[static_cast<std::size_t>(thread)]);
+    for (std::size_t i = begin; i < end; ++i) {
+      Pair& pair = pairs_[i];
+      pair.refreshed = false;
+      if (apartAlongCentres(pair, distance)) {
+        pair.contact = kFar;
+      } else {
+        pair.contact = static_cast<std::uint32_t>(measured.size());
+        measured.push_back(measure(pair, distance));
+      }
+    }
+    measured_[static_cast<std::size_t>(thread)].swap(measured);
+  };
+  workers.run(pairs_.size(), measureRun, 1024);
+  // (The second loop cuts the pairs as the first did: as many, in as many runs.)
+  std::vector<std::size_t> offset(threads, 0);
+  contacts_.clear();
+  bool split = false;
+  for (std::size_t t = 0; t < threads; ++t) {
+    offset[t] = contacts_.size();
+    if (t > 0 && !measured_[t].empty()) split = true;
+    contacts_.insert(contacts_.end(), measured_[t].begin(), measured_[t].end());
+  }
+  if (split) {
+    workers.run(
+        pairs_.size(),
+        [&](std::size_t begin, std::size_t end, int thread) {
+          const auto from = static_cast<std::uint32_t>(offset[static_cast<std::size_t>(thread)]);
+          for (std::size_t i = begin; i < end; ++i) {
+            if (pairs_[i].contact != kFar) pairs_[i].contact += from;
+          }
+        },
+        1024);
+  }
+}
+
+void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch) {
+  const auto gapNow = [&](const Contact& p) {
+    Real g = -p.target;
+    for (int k = 0; k < 4; ++k) g += p.c[k] * glm::dot(p.normal, x_[p.v[k]]);
+    return g;
+  };
+  // How far each unit the two points must part moves the particles: 1 / sum_k c_k^2 w_k, so that
+  // the masses share the move; nothing where that would move a particle more than 1 / kLeverage
+  // times as far as the points part (a held vertex against a triangle whose only free corner has a
+  // small weight there: the pair is then left to the fail-safe rather than the corner flung).
+  const auto reach = [&](const Contact& p) {
+    Real denominator = 0.0, most = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      denominator += p.c[k] * p.c[k] * w_[p.v[k]];
+      most = std::max(most, std::abs(p.c[k]) * w_[p.v[k]]);
+    }
+    if (!(denominator > kLeverage * most)) return 0.0;
+    return 1.0 / denominator;
+  };
+  // Whether the two points still face each other across the normal: their offset along the
+  // surface within the size of the primitives (else one slid off the other's side, or a finger
+  // flung it far, and the half-space of x0 says nothing about them).
+  const auto facing = [&](const Contact& p) {
+    Vec3 offset{0.0};
+    for (int k = 0; k < 4; ++k) offset += x_[p.v[k]] * p.c[k];
+    const Vec3 along = offset - p.normal * glm::dot(p.normal, offset);
+    Real size = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        const Vec3 d = x_[p.v[i]] - x_[p.v[j]];
+        const bool within = p.edges ? (j < 2 || i >= 2) : i >= 1;  // two corners of one primitive
+        if (within) size = std::max(size, glm::dot(d, d));
+      }
+    }
+    return glm::dot(along, along) <= size + p.target * p.target;
+  };
+  // The pairs a sweep can push: within one more `distance` of their target now.
+  active_.clear();
+  for (std::uint32_t i = 0; i < contacts_.size(); ++i) {
+    const Contact& p = contacts_[i];
+    if (p.gap0 > kCoincident && gapNow(p) < distance) active_.push_back(i);
+  }
+  const std::vector<std::uint32_t>& active = active_;
+  for (int sweep = 0; sweep < kSweeps; ++sweep) {
+    for (const std::uint32_t i : active) {
+      Contact& p = contacts_[i];
+      const Real g = gapNow(p);
+      if (g >= 0.0 || !facing(p)) continue;
+      const Real lambda = -g * reach(p);
+      if (!(lambda > 0.0)) continue;
+      for (int k = 0; k < 4; ++k) x_[p.v[k]] += p.normal * (p.c[k] * w_[p.v[k]] * lambda);
+      p.push -= g;
+    }
+    for (const Plane& plane : planes_) {
+      const Real gap = glm::dot(plane.normal, x_[plane.particle]) - plane.offset;
+      if (gap < 0.0) {
+        x_[plane.particle] -= plane.normal * gap;
+        scratch[plane.cloth].contactDepth[plane.index] -= gap;
+      }
+    }
+  }
+  std::int64_t pushed = 0;
+  for (const std::uint32_t i : active) {
+    Contact& p = contacts_[i];
+    if (p.push <= 0.0) continue;
+    ++pushed;
+    if (friction <= 0.0) continue;
+    const Real scale = reach(p);
+    if (!(scale > 0.0)) continue;
+    Vec3 relative{0.0};
+    for (int k = 0; k < 4; ++k) relative += (x_[p.v[k]] - x0_[p.v[k]]) * p.c[k];
+    const Vec3 tangential = relative - p.normal * glm::dot(p.normal, relative);
+    const Real length = glm::length(tangential);
+    if (!(length > 0.0)) continue;
+    const Vec3 change = tangential * (-std::min(friction * p.push / length, 1.0) * scale);
+    for (int k = 0; k < 4; ++k) x_[p.v[k]] += change * (p.c[k] * w_[p.v[k]]);
+  }
+  stats_.pushed = pushed;
+}
+
+void SelfContact::failSafe(Real distance, Workers& workers) {
+  // The boxes must hold every particle's whole motion: where the solve took one beyond its box, the
+  // pairs are found again for the motion as it now is.
+  const std::size_t n = x_.size();
+  keepPairs(nullptr, distance, workers);
+  triangleMoved_.assign(triangles_.size(), 0);
+  if (inZone_.size() != n) inZone_.assign(n, 0);
+  if (stays_.size() != n) stays_.assign(n, 0);
+  bool anyStays = false;                       // a zone stayed at x0 this substep (counted once in the fallbacks)
+  std::vector<std::uint32_t>& stuck = stuck_;  // per round: the zones of pairs that joined nothing
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>& everPassing = everPassing_;  // every round's, in order
+  everPassing.clear();
+  zone_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) zone_[i] = i;
+  const auto root = [&](std::uint32_t i) {
+    while (zone_[i] != i) i = zone_[i] = zone_[zone_[i]];
+    return i;
+  };
+  const std::vector<Vec3> solved = x_;  // each particle's motion as the contacts left it
+  // The exact triangles the tests need, each made once: at x0 once a substep, at x again only where
+  // a zone moved a corner. `slot`: per triangle, where in `made` it is (kNone: not yet).
+  struct Made {
+    std::vector<std::uint32_t>& slot;
+    std::vector<std::optional<exact::Triangle>>& made;
+    std::vector<std::uint32_t>& which;  // the triangles made, to clear their slots
+  };
+  Made at0{slot0_, made0_, which0_}, atX{slotX_, madeX_, whichX_};
+  for (Made* m : {&at0, &atX}) {
+    m->slot.resize(triangles_.size(), kNone);
+    m->made.clear();
+    m->which.clear();
+  }
+  const auto make = [&](Made& m, const std::vector<Vec3>& x, std::uint32_t t) {
+    if (m.slot[t] == kNone) {
+      const glm::uvec3 c = triangles_[t];
+      m.slot[t] = static_cast<std::uint32_t>(m.made.size());
+      m.made.push_back(exact::makeTriangle(x[c[0]], x[c[1]], x[c[2]], {c[0], c[1], c[2]}));
+      m.which.push_back(t);
+    }
+  };
+  // Whether triangles a and b intersect. Particles of one cloth at one grid point are one corner,
+  // as the counter has them (countIntersections): the copies a tear makes, before the seam opens.
+  const auto through = [&](const std::optional<exact::Triangle>& a, const std::optional<exact::Triangle>& b) {
+    if (!a || !b) return false;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (a->upper[axis] < b->lower[axis] || b->upper[axis] < a->lower[axis]) return false;
+    }
+    const auto copies = [&](int i, int j) {
+      return a->particle[i] != b->particle[j] && a->p[i] == b->p[j] &&
+             clothOf_[a->particle[i]] == clothOf_[b->particle[j]];
+    };
+    bool any = false;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) any = any || copies(i, j);
+    }
+    if (!any) return exact::intersect(*a, *b);
+    exact::Triangle unified = *b;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (copies(i, j)) unified.particle[j] = a->particle[i];
+      }
+    }
+    return exact::intersect(*a, unified);
+  };
+  // Neighbours across an edge intersect only folded flat onto each other (exact::intersect), but a
+  // fold pressed through its closed position within the substep passes one through the other all
+  // the same: the free corner d of t goes through s. Seen at the ends: d on opposite sides of the
+  // plane of s at x0 and at x (exact), and, where it crossed that plane (the signed volume taken as
+  // linear in between), on the side of the shared edge where s's own free corner c is (the fold
+  // closed, not opened through flat); a fold flat at x0 aside (kFlatFold). `other`: the corner of t
+  // that s does not have (-1 when they share no edge).
+  const auto other = [&](std::uint32_t s, std::uint32_t t) {
+    const glm::uvec3 a = triangles_[s], b = triangles_[t];
+    int shared = 0, j = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (b[k] == a[0] || b[k] == a[1] || b[k] == a[2]) {
+        ++shared;
+      } else {
+        j = k;
+      }
+    }
+    return shared == 2 ? j : -1;
+  };
+  // The corners: a and b shared, c of s alone, d of t alone.
+  const auto fold = [&](std::uint32_t s, std::uint32_t t, int j) {
+    const glm::uvec3 a = triangles_[s];
+    int i = 0;
+    while (a[i] == triangles_[t][0] || a[i] == triangles_[t][1] || a[i] == triangles_[t][2]) ++i;
+    return std::array<std::uint32_t, 4>{a[(i + 1) % 3], a[(i + 2) % 3], a[i], triangles_[t][j]};
+  };
+  const auto volume = [](const std::vector<Vec3>& x, const std::array<std::uint32_t, 4>& q) {
+    const Vec3 o = x[q[0]];
+    return glm::dot(glm::cross(x[q[1]] - o, x[q[2]] - o), x[q[3]] - o);
+  };
+  // Whether d crossed the plane of s, in doubles: for the parallel look, before the exact one (a
+  // crossing too close to call there is a fold already flat, which exact::intersect judges).
+  const auto mayCross = [&](std::uint32_t s, std::uint32_t t, int j) {
+    const std::array<std::uint32_t, 4> q = fold(s, t, j);
+    return volume(x0_, q) * volume(x_, q) < 0.0;
+  };
+  const auto wrapped = [&](std::uint32_t s, std::uint32_t t) {
+    const int j = other(s, t);
+    if (j < 0) return false;
+    make(at0, x0_, s);
+    make(at0, x0_, t);
+    make(atX, x_, s);
+    make(atX, x_, t);
+    const std::optional<exact::Triangle>&s0 = made0_[slot0_[s]], &t0 = made0_[slot0_[t]];
+    const std::optional<exact::Triangle>&s1 = madeX_[slotX_[s]], &t1 = madeX_[slotX_[t]];
+    if (!s0 || !t0 || !s1 || !t1) return false;
+    const int before = exact::orient3(s0->p[0], s0->p[1], s0->p[2], t0->p[j]);
+    const int after = exact::orient3(s1->p[0], s1->p[1], s1->p[2], t1->p[j]);
+    if (before * after >= 0) return false;
+    const std::array<std::uint32_t, 4> q = fold(s, t, j);
+    const Real v0 = volume(x0_, q), v1 = volume(x_, q);
+    // A fold lying flat at x0 had its corner on no side of the other.
+    const Vec3 o0 = x0_[q[0]];
+    const Real size = glm::length(x0_[q[1]] - o0) * glm::length(x0_[q[2]] - o0) * glm::length(x0_[q[3]] - o0);
+    if (!(std::abs(v0) > kFlatFold * size)) return false;
+    const Real at = v0 != v1 ? std::clamp(v0 / (v0 - v1), Real{0.0}, Real{1.0}) : Real{0.5};
+    const auto then = [&](std::uint32_t k) { return x0_[k] + at * (x_[k] - x0_[k]); };
+    const Vec3 o = then(q[0]), e = then(q[1]) - o, u = then(q[2]) - o, v = then(q[3]) - o;
+    return glm::dot(u, v) * glm::dot(e, e) - glm::dot(u, e) * glm::dot(v, e) > 0.0;
+  };
+  // The triangles the fail-safe tests for a pair: around its vertex against its triangle, or those
+  // on its first edge against those on its second.
+  const auto eachTest = [&](const Pair& p, auto&& f) {
+    if (p.edges) {
+      for (int i = 0; i < 2; ++i) {
+        for (int j = 0; j < 2; ++j) {
+          const std::uint32_t s = edgeTriangles_[2 * p.first + i], t = edgeTriangles_[2 * p.second + j];
+          if (s != kNone && t != kNone) f(s, t);
+        }
+      }
+    } else {
+      for (std::uint32_t k = vertexStart_[p.first]; k < vertexStart_[p.first + 1]; ++k)
+        f(vertexTriangles_[k], p.second);
+    }
+  };
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> passing;
+  std::vector<std::uint32_t> members;  // particles in a zone of more than one
+  std::vector<Vec3> sum;               // per zone root: mass-weighted motion
+  std::vector<Real> weight;
+  std::vector<std::uint64_t>& tests = tests_;
+  std::vector<std::uint8_t>& hits = hits_;
+  // Every round but the last joins two zones or more: at most one round a particle.
+  bool everyPair = true;  // test every pair this round (the first, or the pairs were found again)
+  for (std::uint32_t round = 1;; ++round) {
+    tests.clear();
+    for (Pair& p : pairs_) {
+      if (!everyPair) {
+        // After the first round, only pairs whose tests a zone's move changed.
+        bool moved = false;
+        eachTest(p, [&](std::uint32_t s, std::uint32_t t) { moved = moved || triangleMoved_[s] || triangleMoved_[t]; });
+        if (!moved) continue;
+      }
+      // The largest relative motion of a corner of one against a corner of the other.
+      Real m = 0.0;
+      const int split = p.edges ? 2 : 1;
+      const std::array<std::uint32_t, 4> v = corners(p);
+      for (int i = 0; i < split; ++i) {
+        for (int j = split; j < 4; ++j) {
+          const Vec3 d = (x_[v[i]] - x0_[v[i]]) - (x_[v[j]] - x0_[v[j]]);
+          m = std::max(m, glm::dot(d, d));
+        }
+      }
+      if (p.contact == kFar) {
+        // Far when the solve began: still apart along the line between their centres, or looked
+        // at as any other pair. Apart there by more than the distance when measured, they still
+        // are by more than kProofMargin while no corner has moved a quarter of the difference
+        // since (each side's reach along the line grows by its move; the quarter leaves room for
+        // rounding), which is cheaper to tell.
+        if ((!p.refreshed && stillFar(p)) || apartAlongCentres(p, kProofMargin)) continue;
+        p.contact = static_cast<std::uint32_t>(contacts_.size());
+        contacts_.push_back(measure(p, distance));
+      }
+      // Proven apart all the way: by the gap at x0 against the relative motion, or (a pair near at
+      // x0 whose corners moved apart) along the line between the centres.
+      if (contacts_[p.contact].gap0 > std::sqrt(m) + kProofMargin || apartAlongCentres(p, kProofMargin)) continue;
+      ++stats_.tested;
+      eachTest(p, [&](std::uint32_t s, std::uint32_t t) {
+        tests.push_back((static_cast<std::uint64_t>(std::min(s, t)) << 32) | std::max(s, t));
+      });
+    }
+    // Each pair of triangles once (pairs of primitives share them), in order.
+    std::sort(tests.begin(), tests.end());
+    tests.erase(std::unique(tests.begin(), tests.end()), tests.end());
+    stats_.triangleTests += static_cast<std::int64_t>(tests.size());
+    for (const std::uint64_t key : tests) {
+      make(atX, x_, static_cast<std::uint32_t>(key >> 32));
+      make(atX, x_, static_cast<std::uint32_t>(key));
+    }
+    hits.assign(tests.size(), 0);
+    workers.run(
+        tests.size(),
+        [&](std::size_t begin, std::size_t end, int) {
+          for (std::size_t i = begin; i < end; ++i) {
+            const std::uint64_t key = tests[i];
+            const auto s = static_cast<std::uint32_t>(key >> 32), t = static_cast<std::uint32_t>(key);
+            const int j = other(s, t);
+            hits[i] = through(madeX_[slotX_[s]], madeX_[slotX_[t]]) || (j >= 0 && mayCross(s, t, j));
+          }
+        },
+        256);
+    // Of those that intersect now, the ones that did not at x0; of neighbours, the ones whose fold went through.
+    passing.clear();
+    for (std::size_t i = 0; i < tests.size(); ++i) {
+      if (!hits[i]) continue;
+      const auto s = static_cast<std::uint32_t>(tests[i] >> 32), t = static_cast<std::uint32_t>(tests[i]);
+      make(at0, x0_, s);
+      make(at0, x0_, t);
+      const bool now = through(madeX_[slotX_[s]], madeX_[slotX_[t]]);
+      if (now ? !through(made0_[slot0_[s]], made0_[slot0_[t]]) : wrapped(s, t)) passing.push_back({s, t});
+    }
+    // Before ending: every pair that passed in an earlier round, tested again as the particles
+    // are now. A round's move may leave a pair that still passes where it is (its corners in a
+    // zone whose move did not change, while other pairs joined), and the next round tests only the
+    // triangles that moved.
+    bool verifying = false;
+    if (passing.empty()) {
+      for (const auto& [s, t] : everPassing) {
+        make(atX, x_, s);
+        make(atX, x_, t);
+        if (through(madeX_[slotX_[s]], madeX_[slotX_[t]]) || wrapped(s, t)) passing.push_back({s, t});
+      }
+      if (passing.empty()) break;
+      verifying = true;
+    } else {
+      everPassing.insert(everPassing.end(), passing.begin(), passing.end());
+    }
+    // A pair's free corners join one zone, which moves as one body from x0 by the mass-weighted mean
+    // of its particles' motions: the zone is then as it was at x0, where none of its triangles
+    // intersect, and its momentum is kept. Held and pinned corners are obstacles that move as their
+    // fingers do, until a pair goes on through one whose free corners already move as one (or has
+    // none): then they join the zone too, and it moves as they do on average (they count as
+    // infinitely heavy), the finger's grip slipping for the substep.
+    bool joined = false;
+    stuck.clear();
+    for (const auto& [s, t] : passing) {
+      std::uint32_t corners[6], zoneOfFree = kNone;
+      bool oneZone = true, anyFree = false;
+      for (int k = 0; k < 6; ++k) {
+        corners[k] = triangles_[k < 3 ? s : t][k % 3];
+        if (w_[corners[k]] == 0.0) continue;
+        const std::uint32_t r = inZone_[corners[k]] ? root(corners[k]) : kNone;
+        oneZone = oneZone && r != kNone && (!anyFree || r == zoneOfFree);
+        zoneOfFree = r;
+        anyFree = true;
+      }
+      const bool withHeld = !anyFree || oneZone;
+      std::uint32_t r = kNone;
+      bool grew = false;  // this pair joined a particle or two zones
+      for (const std::uint32_t v : corners) {
+        if (w_[v] == 0.0 && !withHeld) continue;
+        if (!inZone_[v]) {
+          inZone_[v] = 1;
+          members.push_back(v);
+          grew = true;
+        }
+        const std::uint32_t q = root(v);
+        if (r == kNone) {
+          r = q;
+        } else if (q != r) {
+          zone_[q] = r;
+          grew = true;
+        }
+      }
+      joined = joined || grew;
+      if (!grew) stuck.push_back(r);
+    }
+    // A pair that joined nothing goes on through with its corners in one zone already: the zone's
+    // move as one body does not clear it (a translation its triangles do not survive on the exact
+    // grid, where two layers or the two sides of a fresh tear lie closer than its rounding, or
+    // grips that disagree). Once no pair joins anything new, or when the last look above finds the
+    // pair still through, that zone stays at x0 for the substep and the rounds go on: what passes
+    // through a zone that stays joins it and stays too. Every round joins particles or zones or
+    // stops one zone more, so the rounds end; and x0 is clear, so the zones that stay are. Where
+    // nothing is left to join or stop (x0 itself not clear on the exact grid), the whole substep
+    // goes back to x0, where it began.
+    std::vector<std::uint8_t>& stays = staysRoot_;
+    stays.assign(n, 0);
+    for (const std::uint32_t i : members) stays[root(i)] |= stays_[i];
+    bool stopped = false;
+    for (const std::uint32_t r : stuck) {
+      if (joined && !verifying) break;  // while zones grow, a pair that joined nothing waits
+      if (r == kNone || stays[root(r)]) continue;
+      stays[root(r)] = 1;
+      stopped = true;
+    }
+    if ((!joined && !stopped) || round > 2 * n + 2) {
+      x_ = x0_;
+      ++stats_.fallbacks;
+      break;
+    }
+    if (stopped && !anyStays) {
+      ++stats_.fallbacks;
+      anyStays = true;
+    }
+    sum.assign(n, Vec3{0.0});
+    weight.assign(n, 0.0);
+    std::vector<std::uint8_t>& heavy = heavy_;
+    heavy.assign(n, 0);
+    for (const std::uint32_t i : members) heavy[root(i)] |= w_[i] == 0.0;
+    for (const std::uint32_t i : members) {
+      const std::uint32_t r = root(i);
+      if (heavy[r] && w_[i] != 0.0) continue;
+      const Real mass = w_[i] == 0.0 ? 1.0 : 1.0 / w_[i];
+      sum[r] += (solved[i] - x0_[i]) * mass;
+      weight[r] += mass;
+    }
+    std::fill(triangleMoved_.begin(), triangleMoved_.end(), 0);
+    for (const std::uint32_t i : members) {
+      const std::uint32_t r = root(i);
+      stays_[i] = stays[r];
+      const Vec3 moved = stays[r] ? x0_[i] : x0_[i] + sum[r] / weight[r];
+      if (moved != x_[i]) {
+        x_[i] = moved;
+        for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) triangleMoved_[vertexTriangles_[k]] = 1;
+      }
+    }
+    for (const std::uint32_t t : whichX_) {
+      if (triangleMoved_[t]) slotX_[t] = kNone;  // made again where the next round needs it
+    }
+    // A zone's move may take a member out of its box (the zone's mean motion is larger than the
+    // member's own): the pairs then no longer hold every primitive it may meet on its way from x0,
+    // so they are found again for the motion as it now is (refreshed, or searched where many
+    // left), and all tested. (The wide twist, assets/cases/twist-wide.json, left 3 pairs through
+    // each other at 24 x 24 before.)
+    everyPair = keepPairs(&members, distance, workers);
+  }
+  for (Made* m : {&at0, &atX}) {
+    for (const std::uint32_t t : m->which) m->slot[t] = kNone;
+  }
+  stats_.zoned += static_cast<std::int64_t>(members.size());
+  for (const std::uint32_t i : members) inZone_[i] = stays_[i] = 0;
+}
+
+void SelfContact::scatter(std::vector<Cloth>& cloths) const {
+  std::size_t k = 0;
+  for (Cloth& cloth : cloths) {
+    ParticleState& s = cloth.state;
+    for (std::size_t i = 0; i < s.position.size(); ++i, ++k) s.position[i] = x_[k];
+  }
+}
+
+bool SelfContact::prepare(const std::vector<Cloth>& cloths, std::uint64_t topologyVersion) {
+  std::size_t n = 0, nt = 0;
+  for (const Cloth& cloth : cloths) {
+    n += cloth.state.position.size();
+    nt += cloth.rest.triangles.size();
+  }
+  if (topologyVersion == meshVersion_ && n == meshParticles_ && nt == triangles_.size()) return false;
+  buildMesh(cloths);
+  meshVersion_ = topologyVersion;
+  return true;
+}
+
+void SelfContact::settle(std::vector<Cloth>& cloths, const std::vector<std::vector<Vec3>>& before,
+                         const SelfCollisionSettings& settings, std::uint64_t topologyVersion, Workers& workers) {
+  prepare(cloths, topologyVersion);
+  gather(cloths, nullptr, &before);
+  findPairs(settings.distance, 1.0, workers);
+  measurePairs(settings.distance, workers);
+  failSafe(settings.distance, workers);
+  scatter(cloths);
+  distance_ = -1.0;  // the pairs were for this move: the next substep finds its own
+}
+
+void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
+                        const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
+                        Workers& workers, PartClock* clock) {
+  PartClock untimed;
+  PartClock& parts = clock ? *clock : untimed;
+  parts.time(Stage::broadPhase,
+             [&] { findPairsIfNeeded(cloths, scratch, settings, topologyVersion, substepsLeft, workers); });
+  parts.time(Stage::narrowPhase, [&] {
+    measurePairs(settings.distance, workers);
+    stats_.pairs = static_cast<std::int64_t>(pairs_.size());
+  });
+  parts.time(Stage::contactSweep, [&] {
+    sweep(settings.distance, settings.friction, scratch);
+    scatter(cloths);
+  });
+}
+
+void SelfContact::findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
+                                    const SelfCollisionSettings& settings, std::uint64_t topologyVersion,
+                                    int substepsLeft, Workers& workers) {
+  const bool fresh = prepare(cloths, topologyVersion);
+  gather(cloths, &scratch, nullptr);
+  // The pairs found at a substep serve the rest of its step while every particle, at x0 and now,
+  // keeps half a `distance` inside its box: two primitives within `distance` of each other are then
+  // still among them. (A refresh here, of the particles that did not, would find fewer pairs again,
+  // but the boxes of the others, left from earlier, larger motion, then pair them with more: in the
+  // crumple at 64 x 64 twice the memory for a third less time.)
+  if (fresh || distance_ != settings.distance || !strays(nullptr, 0.5 * settings.distance).empty()) {
+    // Looking ahead pays while the motion is smooth enough for the pairs to serve again; where they
+    // did not, the next boxes hold this substep's motion only.
+    findPairs(settings.distance, reused_ ? static_cast<Real>(std::max(substepsLeft, 1)) : 1.0, workers);
+    distance_ = settings.distance;
+    reused_ = false;
+  } else {
+    reused_ = true;
+  }
+}
+
+void SelfContact::finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers,
+                         PartClock* clock) {
+  PartClock untimed;
+  (clock ? *clock : untimed).time(Stage::failSafe, [&] {
+    std::size_t k = 0;
+    for (const Cloth& cloth : cloths) {
+      for (const Vec3& x : cloth.state.position) x_[k++] = x;
+    }
+    failSafe(settings.distance, workers);
+    scatter(cloths);
+  });
+}
+
+}  // namespace drape::sim::contact

@@ -1,0 +1,235 @@
+// Self-contact between triangles: cloth that never passes through itself.
+//
+// Once a substep, after the constraint sweeps, over every cloth of the world at once:
+//
+// 1. Broad phase. Each particle's motion over the substep (from x0, where the substep started, to
+//    x, where the sweeps left it) is boxed, the box grown by `distance`; a triangle's and an edge's
+//    box holds its corners' boxes. A tree of boxes over the mesh (fitted again each search, built
+//    with the mesh) pairs every particle with the triangles and every edge with the edges whose
+//    boxes its own overlaps (not those it is a corner or end of), but not a pair whose boxes lie
+//    apart along the line between the two primitives' centres.
+// 2. Contacts. For each pair, the closest points at x0 (barycentric on the triangle, or along the
+//    two edges) and the direction between them, n. The contact keeps the two points at least the
+//    target apart along n: `distance`, or less for parts of one cloth closer than that at rest. It
+//    is linear in the positions, C(x) = sum_k c_k (n . x_k) - target >= 0 with sum_k c_k = 0, and
+//    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding), except
+//    where that would move a particle far more than the points part (kLeverage). A pair whose
+//    corners lie more than `distance` apart along the line between its centres all through the
+//    substep is far: not measured, not pushed (the fail-safe proves it apart by that line). Then
+//    Coulomb friction in position form on each pair that was pushed: the tangential part of its
+//    relative motion, removed up to `friction` times the push.
+// 3. Fail-safe. Along the straight path from x0 to x, two primitives at x0-distance g can only
+//    meet if their corners' relative motion m (the largest |dx_i - dx_j| between a corner of one
+//    and of the other) reaches g. A pair with m < g is proven apart, as is one whose corners' hulls
+//    over the substep lie apart along the line between its centres. For the others, the triangles
+//    around them are tested exactly (intersections.hpp's test, on the 2^-24 m grid) at x and at x0,
+//    each pair of triangles once a round; where two of them intersect at x and did not at x0, their
+//    free corners join an impact zone, which moves rigidly from x0 by its mass-weighted mean motion
+//    (as it was at x0, so intersection-free, and with its momentum). Held and pinned corners join
+//    only where a zone of free ones still passes through them (then they count as infinitely heavy
+//    and the grip slips for the substep). Then again, testing the pairs whose triangles moved, until
+//    none passes; before the rounds end, every pair that passed in any round is tested once more.
+//    A pair still through with its corners in one zone already (a translation the exact grid's
+//    rounding does not let it survive) stops that zone at x0 for the substep, and what passes
+//    through a zone that stays joins it and stays too. Each round joins or stops something, so it
+//    ends; where nothing is left to join or stop, the whole substep goes back to x0. Where the
+//    contacts or a zone's move take particles out of their boxes, the pairs are found again first:
+//    where fewer than one in eight left, those of the triangles and edges they are corners of only,
+//    each by its box (a refresh: what a search would find), else by a search.
+//
+// A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
+// it would without self-contact. Deterministic whatever the number of threads: the tree's walk lists
+// the overlapping leaves in one order, their pairs are listed in parallel, in blocks of leaves that
+// go to whichever thread is free, each block's in its own lists, joined in the blocks' order, and
+// solved in it; the pairs' contacts are made in each thread's run of them, joined in that order.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "drape/sim/settings.hpp"
+#include "drape/sim/world.hpp"
+#include "collision/exact_triangles.hpp"
+#include "part_clock.hpp"
+#include "solver/solver_scratch.hpp"
+#include "parallel/workers.hpp"
+
+namespace drape::sim::contact {
+
+class SelfContact {
+ public:
+  // A substep's self-contact comes in two calls, and the world applies the colliders' friction
+  // between them (contact::friction), so that it answers to the weight the layers above put on a
+  // layer, and the fail-safe still has the last word. `scratch`: each cloth's collider contacts of
+  // this substep; the sweeps keep them too (a layer pushed down is not pushed through the table),
+  // and what they push out counts into the contact's depth, as the constraint sweeps' does.
+  // `substepsLeft`: in the step, this one included (the pairs found serve them all while they can).
+  // `parts` times the broad and the narrow phase, the sweeps and the fail-safe.
+  void solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch, const SelfCollisionSettings& settings,
+             std::uint64_t topologyVersion, int substepsLeft, Workers& workers, PartClock* parts = nullptr);
+  void finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers,
+              PartClock* parts = nullptr);
+  // Keeps a move made outside the substeps (a tear's relaxation, a cut putting particles on its
+  // line) from passing cloth through cloth: the fail-safe alone, from `before` (per cloth, where each
+  // particle was) to where the particles are, as if a substep had moved them so.
+  void settle(std::vector<Cloth>& cloths, const std::vector<std::vector<Vec3>>& before,
+              const SelfCollisionSettings& settings, std::uint64_t topologyVersion, Workers& workers);
+  const SelfContactStats& stats() const { return stats_; }
+  std::size_t bytes() const;
+
+  // What the broad phase lists: 16 bytes, as many as a hundred a particle in a crumpled pile.
+  struct Pair {
+    std::uint32_t first, second;  // vertex and triangle, or the two edges (the lower first)
+    // Its contact (an index into contacts_), or kFar: apart by more than the distance as the solve
+    // began, so not measured and not pushed.
+    std::uint32_t contact;
+    bool edges;
+    // Listed by a refresh in the fail-safe, after the pairs were measured: not measured with them
+    // (so SelfContact::stillFar says nothing of it).
+    bool refreshed;
+  };
+  static constexpr std::uint32_t kFar = 0xffffffffu;
+  // A pair measured at x0 (those not far): what the sweeps push along.
+  struct Contact {
+    Real c[4];           // the contact point's weights: (1, -b0, -b1, -b2) or (1 - s, s, -(1 - t), -t)
+    Vec3 normal;         // at x0, from the second point to the first
+    Real gap0;           // distance at x0, m
+    Real target;         // m
+    Real push;           // correction along the normal this substep, m (for friction)
+    std::uint32_t v[4];  // the pair's
+    bool edges;
+  };
+  // The pairs last found (by a substep's search, its fail-safe's, or settle's), in the order they
+  // are solved (for tests).
+  const std::vector<Pair>& pairs() const { return pairs_; }
+  // A pair's four particles: vertex-triangle, the vertex and the triangle's corners; edge-edge, the
+  // first edge's ends and the second's.
+  std::array<std::uint32_t, 4> corners(const Pair& pair) const {
+    if (pair.edges) {
+      const glm::uvec2 a = edges_[pair.first], b = edges_[pair.second];
+      return {a[0], a[1], b[0], b[1]};
+    }
+    const glm::uvec3 t = triangles_[pair.second];
+    return {pair.first, t[0], t[1], t[2]};
+  }
+
+ private:
+  // Makes the mesh again if the topology changed; true if it did.
+  bool prepare(const std::vector<Cloth>& cloths, std::uint64_t topologyVersion);
+  // The broad phase: the pairs that may come within reach, found again where the last ones no
+  // longer serve.
+  void findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
+                         const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
+                         Workers& workers);
+  void buildMesh(const std::vector<Cloth>& cloths);
+  void buildTree();
+  void fitTree();
+  // Positions and inverse masses into the world's numbering; x0 from `before` if given (settle),
+  // else each particle's previous position, and the collider contacts from `scratch` if given.
+  void gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>* scratch,
+              const std::vector<std::vector<Vec3>>* before);
+  void scatter(std::vector<Cloth>& cloths) const;
+  void findPairs(Real distance, Real ahead, Workers& workers);
+  void measurePairs(Real distance, Workers& workers);
+  Contact measure(const Pair& pair, Real distance) const;
+  bool apartAlongCentres(const Pair& pair, Real margin) const;
+  // A far pair none of whose corners has moved far enough since it was measured to bring it within
+  // kProofMargin along the line between its centres (what apartAlongCentres would find, sooner).
+  bool stillFar(const Pair& pair) const;
+  void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
+  void failSafe(Real distance, Workers& workers);
+  // Of `candidates` (every particle where null), those not `margin` inside their boxes at x0 and
+  // now (in strays_).
+  const std::vector<std::uint32_t>& strays(const std::vector<std::uint32_t>* candidates, Real margin);
+  // In the fail-safe: the pairs kept whole for the motion as it now is, where any of `candidates`
+  // left its box: by a refresh of the few that did (their primitives paired again by their boxes,
+  // the particles' boxes now their motion), or a search where many did; whether either was needed.
+  bool keepPairs(const std::vector<std::uint32_t>* candidates, Real distance, Workers& workers);
+  void refresh(const std::vector<std::uint32_t>& strays);
+  // A triangle's or edge's box from its corners' (k: its index among the boxes), or none where it
+  // is torn; whether it is; whether two primitives' boxes lie apart along `axis` (findPairs).
+  void boxPrimitive(std::size_t k);
+  bool torn(const std::uint32_t* corners, int count) const;
+  bool apartBoxes(const std::uint32_t* corners, int split, Vec3 axis) const;
+
+  std::uint64_t meshVersion_ = 0;
+  std::size_t meshParticles_ = 0;
+  // The world's mesh, particles numbered across cloths.
+  std::vector<std::uint32_t> clothOf_;                        // per particle
+  std::vector<Vec3> rest_;                                    // rest positions
+  std::vector<Real> clothSize_;                               // per cloth: its rest box's diagonal, squared
+  std::vector<glm::uvec3> triangles_;                         // world-wide corners
+  std::vector<glm::uvec2> edges_;                             // unique, lower particle first
+  std::vector<std::uint32_t> edgeTriangles_;                  // two per edge (kNone where only one)
+  std::vector<std::uint32_t> vertexStart_, vertexTriangles_;  // the triangles around each particle
+
+  // This substep.
+  std::vector<Vec3> x0_, x_;  // where each particle was when the substep began, and is now
+  Real distance_ = 0.0;       // the pairs were found for
+  bool reused_ = true;        // the pairs last found served a second substep
+  std::vector<Real> w_;       // inverse masses
+  struct Plane {
+    std::uint32_t particle;
+    std::uint32_t cloth, index;  // of the particle in its cloth
+    Vec3 normal;
+    Real offset;  // the particle keeps normal . x >= offset
+  };
+  std::vector<Plane> planes_;                   // the collider contacts of this substep
+  std::vector<Vec3> lower_, upper_;             // boxes of the particles, triangles, edges: in that order
+  std::vector<glm::vec3> boxLower_, boxUpper_;  // the same in single precision, rounded outwards
+  Real grow_ = 0.0;                             // how far the boxes reach beyond the motion, m
+  // A refresh's primitives (particles, triangles, edges, flagged), the particles that left their
+  // boxes, and the tree's walk.
+  std::vector<std::uint8_t> affected_;
+  std::vector<std::uint32_t> strays_, walk_;
+  // The broad phase's tree (a bounding-volume hierarchy), built with the mesh from the rest shape:
+  // cloth by cloth, then halving the triangles at the median along the longest side of their rest
+  // centroids, down to leaves of at most kLeafTriangles items (triangles, and particles in no
+  // triangle). Every primitive belongs to one leaf: a
+  // triangle to its own, a vertex and an edge to the leaf of their first triangle (a particle in
+  // no triangle, as a chain's, to a leaf of its own). A search fits each leaf's box around what it
+  // holds and each node's around its children, then walks the tree against itself for the pairs
+  // of leaves whose boxes overlap, and tests their primitives: each pair of primitives whose boxes
+  // overlap is then found exactly once, in the pair of leaves that hold them.
+  struct Node {
+    glm::vec3 lower, upper;
+    std::uint32_t left, right;  // children; a leaf: right is kNone and left its leaf
+  };
+  std::vector<Node> nodes_;                                       // parents before children
+  std::vector<std::uint32_t> leafTriangleStart_, leafTriangles_;  // per leaf, its triangles
+  std::vector<std::uint32_t> leafVertexStart_, leafVertices_;     // ... its vertices
+  std::vector<std::uint32_t> leafEdgeStart_, leafEdges_;          // ... its edges
+  std::vector<std::uint32_t> leafNode_;                           // per leaf, its node
+  std::vector<std::uint64_t> leafPairs_;  // this search's overlapping leaves (lower in the high word)
+  std::vector<std::uint64_t> stack_;      // the walk's node pairs still to look at
+  std::vector<std::vector<Pair>> found_;  // per block of leaf pairs: vertex-triangle pairs, then edge-edge pairs
+  std::vector<std::int64_t> boxTests_;    // per thread: primitive boxes compared
+  std::vector<Pair> pairs_;
+  std::vector<Contact> contacts_;               // the pairs not far, in the pairs' order (then the fail-safe's)
+  std::vector<std::vector<Contact>> measured_;  // per thread, as measurePairs makes them
+  std::vector<std::uint32_t> active_;           // contacts the sweeps look at
+  std::vector<Vec3> xMeasured_;                 // x as the pairs were last measured
+  Real measuredDistance_ = 0.0;                 // the distance they were measured for
+  // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is
+  // in a zone, and (per zone root) whether a held or pinned particle is in it; per triangle, whether
+  // the last round moved a corner; whether a zone stays at x0 for the substep (its move as one body
+  // did not clear a pair through it), per member and per zone root in a round; the round's zones of
+  // such pairs; and the substep's pairs through, every round's.
+  std::vector<std::uint32_t> zone_;
+  std::vector<std::uint8_t> inZone_, heavy_, triangleMoved_, stays_, staysRoot_;
+  std::vector<std::uint32_t> stuck_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> everPassing_;
+  // Its exact tests: the pairs of triangles of a round (lower index in the high word) and whether
+  // each intersects now; the exact triangles made at x0 and at x (slot per triangle, kNone if not
+  // made, and the triangles made).
+  std::vector<std::uint64_t> tests_;
+  std::vector<std::uint8_t> hits_;
+  std::vector<std::uint32_t> slot0_, slotX_, which0_, whichX_;
+  std::vector<std::optional<exact::Triangle>> made0_, madeX_;
+  SelfContactStats stats_;
+};
+
+}  // namespace drape::sim::contact

@@ -1,0 +1,642 @@
+#include "solver/lines.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+#include <type_traits>
+
+#include <glm/geometric.hpp>
+
+#include "solver/lines_wide.hpp"
+#include "solver/position_model.hpp"
+#include "solver/stiff_lanes.hpp"
+
+namespace drape::sim::lines {
+
+namespace {
+
+std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+// A line's particles and links, read from the cloth's stretch constraints in line order (build):
+// link k joins particle k, its a, to particle k + 1, its b.
+struct Line {
+  const DistanceConstraint* link = nullptr;
+  ParticleIndex operator[](std::size_t k) const { return k == 0 ? link[0].a : link[k - 1].b; }
+};
+
+// Solves G lines of n particles each in place, interleaved: line g has particles p[g][0..n) and
+// links p[g].link[0..n-2]. Each line's arithmetic is the same whatever G is; interleaving only lets the core
+// overlap the lines' chains of divisions (Thomas' recurrence is serial within a line).
+// Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
+//
+// With kAlongStart (XPBD) each link moves its particles along its direction at the substep's start
+// where it is slack enough (position::alongStart), which keeps the cloth's angular momentum:
+// dx_k = w_k (dlambda_{k-1} n0_{k-1} - dlambda_k n0_k), dlambda from the system above.
+template <std::size_t G, bool kAlongStart>
+void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array<Real*, G>& lambda,
+                const std::array<float*, G>& summed, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
+                Vec3* normal, Real* upper, Real* solution) {
+  const std::size_t links = n - 1;
+  Vec3* x = s.position.data();
+  const Real* w = s.inverseMass.data();
+  // Directions, diagonal (in upper) and right-hand side (in solution). A link whose particles
+  // coincide, or that nothing can move, gets the row of the identity and no correction.
+  for (std::size_t k = 0; k < links; ++k) {
+    for (std::size_t g = 0; g < G; ++g) {
+      const std::size_t at = k * G + g;
+      const DistanceConstraint& c = p[g].link[k];
+      const Vec3 d = x[c.b] - x[c.a];
+      const Real length2 = glm::dot(d, d);
+      const Real diagonal = w[c.a] + w[c.b] + alphaTilde;
+      if (length2 > 1e-20 && diagonal > 0.0) {
+        const Real length = std::sqrt(length2);
+        normal[at] = d * (1.0 / length);
+        upper[at] = diagonal;
+        solution[at] = -(length - c.restLength) - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0);
+      } else {
+        normal[at] = Vec3{0.0};
+        upper[at] = 1.0;
+        solution[at] = 0.0;
+      }
+    }
+  }
+  // Thomas' algorithm. Row k couples to link k - 1 by -w_k (n_{k-1} . n_k), to link k + 1 by
+  // -w_{k+1} (n_k . n_{k+1}); upper[k] becomes the eliminated upper entry, solution[k] the
+  // eliminated right-hand side.
+  // The matrix is symmetric: row k's coupling to link k + 1 is row k + 1's to link k.
+  std::array<Real, G> previousUpper{}, previousSolution{}, previousCoupling{};
+  for (std::size_t k = 0; k < links; ++k) {
+    for (std::size_t g = 0; g < G; ++g) {
+      const std::size_t at = k * G + g;
+      const Real lower = previousCoupling[g];
+      const Real diagonal = upper[at];
+      Real pivot = diagonal - lower * previousUpper[g];
+      // Only a particle caught between two immovable ones on a straight line makes the system
+      // singular; that link is then corrected as if alone.
+      if (!(pivot > 1e-9 * diagonal)) pivot = diagonal;
+      const Real inverse = 1.0 / pivot;
+      const Real coupling = k + 1 < links ? -w[p[g].link[k].b] * glm::dot(normal[at], normal[at + G]) : 0.0;
+      previousCoupling[g] = coupling;
+      upper[at] = coupling * inverse;
+      solution[at] = (solution[at] - lower * previousSolution[g]) * inverse;
+      previousUpper[g] = upper[at];
+      previousSolution[g] = solution[at];
+    }
+  }
+  for (std::size_t k = links - 1; k-- > 0;) {
+    for (std::size_t g = 0; g < G; ++g) solution[k * G + g] -= upper[k * G + g] * solution[(k + 1) * G + g];
+  }
+  for (std::size_t k = 0; k < links; ++k) {
+    for (std::size_t g = 0; g < G; ++g) {
+      const std::size_t at = k * G + g;
+      const Real dl = solution[at] * stiffness;
+      if (lambda[g]) lambda[g][k] += dl;
+      if (summed[g]) summed[g][k] = static_cast<float>((restart ? 0.0f : summed[g][k]) + dl);
+      const DistanceConstraint& c = p[g].link[k];
+      Vec3 along = normal[at];
+      if constexpr (kAlongStart) {
+        // (The substep's multiplier so far; a caller that keeps none has only this step's.)
+        along = position::alongStart(along, s.previousPosition[c.a], s.previousPosition[c.b],
+                                     lambda[g] ? lambda[g][k] : dl, w[c.a] + w[c.b], c.restLength);
+      }
+      const Vec3 push = along * dl;
+      x[c.a] -= push * w[c.a];
+      x[c.b] += push * w[c.b];
+    }
+  }
+}
+
+// The full Newton step runs in single precision, lines side by side in vector lanes
+// (stiff_lanes.hpp): eight to an AVX register where the CPU has AVX (cpuHasAvx), else four to an SSE
+// one. It only has to find the direction the second, double-precision step refines (the links'
+// lengths it leaves are that step's to correct).
+//
+// One full Newton step of G lines' projections from where their particles are now, geometric
+// stiffness included: with dx the particles' moves and l the links' multipliers,
+//   K dx - J^T l = 0,   J dx + alpha~ l = -(C + alpha~ lambda),
+//   K = M + sum_k G_k (on link k's two particles: [G, -G; -G, G]), G_k = g_k (I - n_k n_k^T),
+// g_k = the link's tension (times h^2: the substep's multipliers so far, at its first step the last
+// substep's) over its length (Tournier et al.
+// 2015, Andrews et al. 2017). Without G this is solveLines' tridiagonal system; with it a
+// particle's sideways move drags its neighbours, as a taut string's does. The unknowns are
+// eliminated in the order x_0, x_1, l_0, x_2, l_1, ...: a front of one particle and one link (a
+// 3 x 3 inverse and a scalar pivot), so a held particle (whose unknowns drop out) never leaves a
+// link's multiplier without a pivot. rows holds n rows; the lines' data is gathered into lanes,
+// solved by solveStiffLanes W (4 or 8) lanes at once (the first G filled; the others hold a held
+// particle and no link), and the moves and multipliers scattered back.
+// (FixedG: the number of lines G when it is known at compile time, a full group; 0: given as count.)
+template <std::size_t W, std::size_t FixedG>
+void solveStiffLines(ParticleState& s, std::size_t count, const std::array<Line, W>& p,
+                     const std::array<Real*, W>& lambda, const std::array<float*, W>& tension, bool restart,
+                     std::size_t n, Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
+  static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
+  // Eight lines whose particles at each k are consecutive (p[g][k] = p[0][k] + g) are gathered and
+  // scattered eight particles at a time (lines_wide.cpp): the same bits as below.
+  constexpr bool kWide = W == 8 && FixedG == 8;
+  const std::size_t G = FixedG != 0 ? FixedG : count;
+  using Row = SolverScratch::StiffRows;
+  Vec3* x = s.position.data();
+  const Real* w = s.inverseMass.data();
+  const MassReal* mass = s.mass.data();
+  const std::size_t links = n - 1;
+  // Gathered first: each link's direction, value and geometric stiffness, each particle's mass.
+  // Each line's system is solved in units of its first particle's mass (K / s, alpha~ s, l / s,
+  // s = that mass), so that single precision holds whatever the cloth weighs.
+  std::array<Real, W> unitMass, perUnitMass;
+  unitMass.fill(1.0);
+  perUnitMass.fill(1.0);
+  float alpha[W]{};
+  for (std::size_t g = 0; g < G; ++g) {
+    unitMass[g] = mass[p[g][0]] > 0.0 ? mass[p[g][0]] : 1.0;
+    perUnitMass[g] = 1.0 / unitMass[g];
+    alpha[g] = static_cast<float>(alphaTilde * unitMass[g]);
+  }
+  // Each link's difference (in double: the particles' distance from the origin may be a thousand
+  // links), rest length, tension, and whether anything can move it; solveStiffLanes makes of them
+  // the link's direction, value and geometric stiffness (normalise). Each line's particle at k + 1
+  // is carried over as the next link's first. Lanes no line fills hold a held particle and no link.
+  const bool wide = kWide && consecutive;
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "the wide gather reads positions as x, y, z doubles");
+  if (wide) {
+    std::array<const DistanceConstraint*, W> lineLinks{};
+    for (std::size_t g = 0; g < W; ++g) lineLinks[g] = p[g].link;
+    gatherConsecutiveWide(rows, n, reinterpret_cast<const double*>(x), w, mass, p[0].link, lineLinks.data(),
+                          lambda.data(), tension.data(), perUnitMass.data(), alphaTilde);
+  } else {
+    std::array<Vec3, W> from;
+    std::array<Real, W> fromW;
+    for (std::size_t g = 0; g < G; ++g) {
+      from[g] = x[p[g][0]];
+      fromW[g] = w[p[g][0]];
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      Row& r = rows[k];
+      for (std::size_t g = 0; g < G; ++g) {
+        r.v[0][g] = static_cast<float>(mass[p[g][k]] * perUnitMass[g]);  // (StiffRows: what v holds before)
+        r.v[1][g] = fromW[g] > 0.0 ? 1.0f : 0.0f;
+        if (k == links) {
+          r.nx[g] = r.ny[g] = r.nz[g] = r.yl[g] = r.g[g] = r.schur[g] = 0.0f;
+          continue;
+        }
+        const DistanceConstraint& c = p[g].link[k];
+        const Vec3 to = x[c.b];
+        const Real toW = w[c.b];
+        const Vec3 d = to - from[g];
+        r.nx[g] = static_cast<float>(d.x);
+        r.ny[g] = static_cast<float>(d.y);
+        r.nz[g] = static_cast<float>(d.z);
+        // C + alpha~ lambda = length - (rest - alpha~ lambda)
+        r.yl[g] = static_cast<float>(c.restLength - (lambda[g] ? alphaTilde * lambda[g][k] : 0.0));
+        // Pulled links only: a pushed one would make K indefinite.
+        r.g[g] = static_cast<float>(std::max(-static_cast<Real>(tension[g][k]), 0.0) * perUnitMass[g]);
+        r.schur[g] = fromW[g] + toW + alphaTilde > 0.0 ? 1.0f : 0.0f;
+        from[g] = to;
+        fromW[g] = toW;
+      }
+      for (std::size_t g = G; g < W; ++g) {
+        r.v[0][g] = 1.0f;
+        r.v[1][g] = r.nx[g] = r.ny[g] = r.nz[g] = r.yl[g] = r.g[g] = r.schur[g] = 0.0f;
+      }
+    }
+  }
+  // A held particle or a dead link is masked, not branched on.
+  if constexpr (W == 8) {
+    solveStiffLanesWide(rows, n, alpha);
+  } else {
+    solveStiffLanes<Narrow>(rows, n, load<Narrow>(alpha));
+  }
+  // A dead link's multiplier comes out 0 and is added all the same; a held particle is not touched
+  // (its move is 0 too, but it must stay put even if something upstream went non-finite).
+  std::array<Real, W> multiplierScale{};
+  for (std::size_t g = 0; g < G; ++g) multiplierScale[g] = unitMass[g] * stiffness;
+  if (wide) scatterConsecutiveWide(rows, n, reinterpret_cast<double*>(x), w, p[0].link, stiffness);
+  for (std::size_t j = 0; j < n; ++j) {
+    const Row& r = rows[j];
+    for (std::size_t g = 0; g < G; ++g) {
+      if (!wide && w[p[g][j]] > 0.0) x[p[g][j]] += Vec3{r.yx[0][g], r.yx[1][g], r.yx[2][g]} * stiffness;
+      if (j == 0) continue;
+      const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
+      if (lambda[g]) lambda[g][j - 1] += multiplier;
+      tension[g][j - 1] = static_cast<float>((restart ? 0.0f : tension[g][j - 1]) + multiplier);
+    }
+  }
+}
+
+// Where lines line[0, G) of a family start (their slots), their links (in `stretch`, the cloth's
+// stretch constraints) and multipliers (null without XPBD), in arrays of N.
+template <std::size_t N>
+struct LineData {
+  std::array<Line, N> p{};
+  std::array<Real*, N> lambda{};
+  std::array<std::size_t, N> offset{};
+};
+template <std::size_t N>
+LineData<N> lineData(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
+                     std::size_t G, bool xpbd) {
+  LineData<N> d;
+  for (std::size_t g = 0; g < G; ++g) {
+    d.offset[g] = lines.start[line[g]];
+    d.p[g].link = stretch + lines.firstLink(line[g]);
+    d.lambda[g] = xpbd ? lines.lambda.data() + d.offset[g] : nullptr;
+  }
+  return d;
+}
+
+// The lines line[0, count) of a family, W at a time where W in a row are equally long (G = W),
+// else one (G = 1): solve(std::integral_constant<std::size_t, G>, lines, lambdas, offsets, n),
+// each array holding G lines' (lambdas null without XPBD) and offsets their slots. A line's arithmetic does not depend
+// on which lines it is solved beside. (The vector solve takes up to W in a row instead: inLanes.)
+template <std::size_t W, class Solve>
+void inGroups(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
+              std::size_t count, bool xpbd, Solve&& solve) {
+  constexpr std::size_t G = W;
+  const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
+  const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t i, std::size_t n) {
+    const LineData<N> d = lineData<N>(lines, stretch, line + i, N, xpbd);
+    solve(size, d.p, d.lambda, d.offset, n);
+  };
+  for (std::size_t i = 0; i < count;) {
+    const std::size_t n = length(i);
+    bool group = i + G <= count && n >= 2;
+    for (std::size_t g = 1; group && g < G; ++g) group = length(i + g) == n;
+    if (group) {
+      gather(std::integral_constant<std::size_t, G>{}, i, n);
+      i += G;
+      continue;
+    }
+    if (n >= 2) gather(std::integral_constant<std::size_t, 1>{}, i, n);
+    ++i;
+  }
+}
+
+// The lines line[0, count) of a family, up to W at a time, as many equally long ones as follow
+// each other: solve(G, lines, lambdas, offsets, n, ids), each array holding W lines' of which the
+// first G are filled (lambdas null without XPBD), and ids their indices.
+// A lane left empty costs as much as a filled one, so a short group beats lines one by one.
+template <std::size_t W, class Solve>
+void inLanes(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
+             std::size_t count, bool xpbd, Solve&& solve) {
+  const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
+  for (std::size_t i = 0; i < count;) {
+    const std::size_t n = length(i);
+    if (n < 2) {
+      ++i;
+      continue;
+    }
+    std::size_t G = 1;
+    while (G < W && i + G < count && length(i + G) == n) ++G;
+    const LineData<W> d = lineData<W>(lines, stretch, line + i, G, xpbd);
+    solve(G, d.p, d.lambda, d.offset, n, line + i);
+    i += G;
+  }
+}
+
+// Whether line l needs the full Newton step: whether, at any of its links, the geometric stiffness
+// g = tension / length reaches `ratio` (a tenth) of the particle's mass m. g / m is (c h / r)^2, the square
+// of how many links a sideways wave (speed c = sqrt(T / mu)) crosses in a substep: below a third
+// of a link the tridiagonal step keeps a kink from growing, and g changes the step by a tenth at
+// most. (hang2 256: most rows are below it, every column above; the strains it reaches do not
+// change. Rest lengths stand in for lengths.)
+bool needsFullStep(const SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, std::size_t l,
+                   const MassReal* mass, Real ratio) {
+  const DistanceConstraint* link = stretch + lines.firstLink(l);
+  const float* tension = lines.tension.data() + lines.start[l];
+  for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {
+    if (-tension[k] >= ratio * link[k].restLength * mass[link[k].a]) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool cpuHasAvx() {
+#if (defined(__x86_64__) || defined(__i386__)) && defined(DRAPE_WIDE_LANES)
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx") != 0;  // and the system saves its registers
+  }();
+  return has;
+#else
+  return false;
+#endif
+}
+
+void build(Cloth& cloth, SolverScratch& scratch, int threads) {
+  std::vector<DistanceConstraint>& stretch = cloth.rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
+  const std::size_t n = cloth.rest.particleCount();
+  // The links are taken in the order of their particles, not of the array: which join a line then
+  // does not depend on the order the constraints come in, so building again from the order this
+  // leaves them in (a snapshot, another thread count) gives the same lines.
+  std::vector<std::uint32_t> byPair(stretch.size());
+  std::iota(byPair.begin(), byPair.end(), 0u);
+  const auto pair = [&](std::uint32_t k) {
+    const DistanceConstraint& c = stretch[k];
+    return std::pair{std::min(c.a, c.b), std::max(c.a, c.b)};
+  };
+  std::stable_sort(byPair.begin(), byPair.end(), [&](std::uint32_t l, std::uint32_t r) { return pair(l) < pair(r); });
+  std::vector<DistanceConstraint> ordered;  // the links of the lines, line by line; then the loose
+  ordered.reserve(stretch.size());
+  std::vector<std::uint32_t> from;  // where each came from
+  from.reserve(stretch.size());
+  std::array<std::vector<std::uint32_t>, 2> loose;
+  std::size_t longest = 0;
+  for (int family = 0; family < 2; ++family) {
+    SolverScratch::LineFamily& lines = scratch.lines[static_cast<std::size_t>(family)];
+    lines = {};
+    lines.linkBase = static_cast<std::uint32_t>(ordered.size());
+    std::vector<std::uint8_t> degree(n, 0);
+    std::vector<std::uint32_t> parent(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    std::vector<std::array<std::int64_t, 2>> next(n, {-1, -1});  // the constraints at each particle
+    for (const std::uint32_t k : byPair) {
+      const DistanceConstraint& c = stretch[k];
+      const Vec3 d = glm::abs(cloth.rest.restPosition(c.b) - cloth.rest.restPosition(c.a));
+      const bool alongX = d.x >= std::max(d.y, d.z);
+      if (alongX != (family == 0)) continue;
+      const std::uint32_t ra = findRoot(parent, c.a), rb = findRoot(parent, c.b);
+      if (degree[c.a] >= 2 || degree[c.b] >= 2 || ra == rb) {
+        loose[static_cast<std::size_t>(family)].push_back(k);
+        continue;
+      }
+      parent[ra] = rb;
+      next[c.a][degree[c.a]++] = k;
+      next[c.b][degree[c.b]++] = k;
+    }
+    // Walk each line from one of its ends, turning each link to point along it.
+    std::vector<std::uint8_t> done(n, 0);
+    std::uint32_t slots = 0;
+    for (std::size_t start = 0; start < n; ++start) {
+      if (degree[start] != 1 || done[start]) continue;
+      lines.start.push_back(slots);
+      std::size_t at = start;
+      std::int64_t previous = -1;
+      std::size_t length = 0;
+      while (true) {
+        done[at] = 1;
+        ++slots;
+        ++length;
+        std::int64_t link = -1;
+        for (std::int64_t candidate : next[at]) {
+          if (candidate >= 0 && candidate != previous) link = candidate;
+        }
+        if (link < 0) break;
+        DistanceConstraint c = stretch[static_cast<std::size_t>(link)];
+        if (c.a != at) std::swap(c.a, c.b);
+        ordered.push_back(c);
+        from.push_back(static_cast<std::uint32_t>(link));
+        at = c.b;
+        previous = link;
+      }
+      longest = std::max(longest, length);
+    }
+    lines.start.push_back(slots);
+  }
+  scratch.looseStretch.clear();
+  for (const std::vector<std::uint32_t>& family : loose) {
+    for (const std::uint32_t k : family) {
+      scratch.looseStretch.push_back(static_cast<std::uint32_t>(ordered.size()));
+      ordered.push_back(stretch[k]);
+      from.push_back(k);
+    }
+  }
+  // A torn cloth's constraints each name their recipe: the names move with them.
+  std::vector<std::uint32_t>& source = cloth.topology.source[static_cast<std::size_t>(ConstraintKind::stretch)];
+  if (cloth.topology.built && source.size() == from.size()) {
+    std::vector<std::uint32_t> moved(from.size());
+    for (std::size_t k = 0; k < from.size(); ++k) moved[k] = source[from[k]];
+    source.swap(moved);
+  }
+  stretch.swap(ordered);
+  for (SolverScratch::LineFamily& lines : scratch.lines) {
+    const std::size_t count = lines.start.size() - 1;
+    lines.besideNext.assign(count, 0);
+    for (std::size_t l = 0; l + 1 < count; ++l) {
+      const std::uint32_t length = lines.start[l + 1] - lines.start[l];
+      bool beside = lines.start[l + 2] - lines.start[l + 1] == length;
+      const Line here{stretch.data() + lines.firstLink(l)}, beyond{stretch.data() + lines.firstLink(l + 1)};
+      for (std::uint32_t k = 0; beside && k < length; ++k) beside = beyond[k] == here[k] + 1;
+      lines.besideNext[l] = beside ? 1 : 0;
+    }
+  }
+  scratch.stiffLanes = cpuHasAvx() ? 8 : 4;
+  scratch.lineStride = longest * 4;  // four lines interleaved
+  const std::size_t slices = scratch.lineStride * static_cast<std::size_t>(std::max(threads, 1));
+  scratch.lineNormal.assign(slices, Vec3{0.0});
+  scratch.lineUpper.assign(slices, 0.0);
+  scratch.lineSolution.assign(slices, 0.0);
+}
+
+void beginSubstep(SolverScratch& scratch) {
+  for (SolverScratch::LineFamily& lines : scratch.lines) {
+    lines.fresh = true;
+    lines.ordered = false;
+  }
+}
+
+void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+          bool full, Workers& workers) {
+  ParticleState& s = cloth.state;
+  const DistanceConstraint* stretch = cloth.rest.of(ConstraintKind::stretch).data();
+  const bool fullStep = full && geometricStiffness;
+  if (geometricStiffness) {
+    const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
+    if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
+    for (SolverScratch::LineFamily& lines : scratch.lines) {  // sized here alone (zero: no tension yet)
+      lines.tension.resize(lines.slots(), 0.0f);
+    }
+  }
+  for (SolverScratch::LineFamily& lines : scratch.lines) {
+    if (lines.start.size() < 2) continue;
+    const std::size_t count = lines.start.size() - 1;
+    // Shared out only where each thread gets a few thousand links: below that, waking a helper
+    // costs more than it saves.
+    const std::size_t perLine = std::max<std::size_t>(lines.slots() / count, 1);
+    const std::size_t grain = std::max<std::size_t>(2048 / perLine, 1);
+    // The lines taut enough to need the full step (needsFullStep) are solved first, then the
+    // others, each share taken by the workers in blocks: a full step costs about twice a
+    // tridiagonal one, and the taut lines bunch together (near the pins).
+    // The flags come from the tension at the substep's first full step (the last substep's) and
+    // hold for the whole substep.
+    if (fullStep && !lines.ordered) {
+      lines.taut.resize(count);
+      lines.order.resize(count);
+      workers.run(
+          count,
+          [&](std::size_t first, std::size_t last, int) {
+            for (std::size_t l = first; l < last; ++l) {
+              lines.taut[l] = needsFullStep(lines, stretch, l, s.mass.data(), scratch.fullStepRatio) ? 1 : 0;
+            }
+          },
+          grain);
+      std::size_t taut = 0;
+      for (std::size_t l = 0; l < count; ++l) {
+        if (lines.taut[l]) lines.order[taut++] = static_cast<std::uint32_t>(l);
+      }
+      for (std::size_t l = 0, slack = taut; l < count; ++l) {
+        if (!lines.taut[l]) lines.order[slack++] = static_cast<std::uint32_t>(l);
+      }
+      lines.tautCount = taut;
+      lines.ordered = true;
+    } else if (!lines.ordered) {  // any order will do: every line takes the tridiagonal step
+      lines.order.resize(count);
+      std::iota(lines.order.begin(), lines.order.end(), 0u);
+    }
+    const std::size_t taut = fullStep ? lines.tautCount : 0;
+    // A substep's first step starts its sum: it reads the last substep's and writes its own.
+    const bool restart = lines.fresh;
+    for (const bool stiff : {true, false}) {
+      const std::size_t from = stiff ? 0 : taut, to = stiff ? taut : count;
+      if (from == to) continue;
+      // Eight lines a block (whole groups for the vector solves), taken by whichever thread is free.
+      workers.runShared(
+          to - from, 8,
+          [&](std::size_t first, std::size_t last, int thread) {
+            const Real alpha = xpbd ? alphaTilde : 0.0;
+            const std::size_t slice = scratch.lineStride * static_cast<std::size_t>(thread);
+            const std::uint32_t* line = lines.order.data() + from + first;
+            if (stiff) {
+              const auto solveStiff = [&]<std::size_t W>(std::integral_constant<std::size_t, W>) {
+                inLanes<W>(lines, stretch, line, last - first, xpbd,
+                           [&](std::size_t G, const auto& p, const auto& lambda, const auto& offset, std::size_t n,
+                               const std::uint32_t* ids) {
+                             // The tension is read and summed in the same array: a line's gather
+                             // reads its links' before its scatter adds to them.
+                             std::array<float*, W> tension{};
+                             for (std::size_t g = 0; g < G; ++g) tension[g] = lines.tension.data() + offset[g];
+                             StiffRow* rows = scratch.lineStiff.data() + slice / 4;
+                             if (G == W) {
+                               bool consecutive = true;
+                               for (std::size_t g = 0; consecutive && g + 1 < W; ++g) {
+                                 consecutive = ids[g + 1] == ids[g] + 1 && lines.besideNext[ids[g]];
+                               }
+                               solveStiffLines<W, W>(s, G, p, lambda, tension, restart, n, stiffness, alpha, rows,
+                                                     consecutive);
+                             } else {
+                               solveStiffLines<W, 0>(s, G, p, lambda, tension, restart, n, stiffness, alpha, rows,
+                                                     false);
+                             }
+                           });
+              };
+              if (scratch.stiffLanes == 8) {
+                solveStiff(std::integral_constant<std::size_t, 8>{});
+              } else {
+                solveStiff(std::integral_constant<std::size_t, 4>{});
+              }
+            } else {
+              // With geometric stiffness every solve adds its multipliers to the tension sums.
+              inGroups<4>(
+                  lines, stretch, line, last - first, xpbd,
+                  [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
+                                     const auto& offset, std::size_t n) {
+                    std::array<float*, G> summed{};
+                    for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
+                      summed[g] = lines.tension.data() + offset[g];
+                    }
+                    Vec3* normal = scratch.lineNormal.data() + slice;
+                    Real* upper = scratch.lineUpper.data() + slice;
+                    Real* solution = scratch.lineSolution.data() + slice;
+                    if (xpbd) {
+                      solveLines<G, true>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
+                    } else {
+                      solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
+                    }
+                  });
+            }
+          },
+          grain);
+    }
+    if (geometricStiffness) lines.fresh = false;
+  }
+}
+
+void solveLoose(Cloth& cloth, const SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde,
+                Real* looseLambda) {
+  ParticleState& s = cloth.state;
+  const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
+  for (const std::uint32_t k : scratch.looseStretch) {
+    if (xpbd && looseLambda) {
+      position::projectCompliant(s.position, s.previousPosition, s.inverseMass, stretch[k], alphaTilde, looseLambda[k]);
+    } else {
+      position::projectDistance(s.position, s.inverseMass, stretch[k], stiffness);
+    }
+  }
+}
+
+namespace {
+
+// Whether some link of a line, one of whose particles is free to move, is longer than
+// (1 + tolerance) times its rest length. The lines are shared among the workers as the steps share
+// them; any that finds one stops the others looking.
+bool stretchedBeyond(const Cloth& cloth, const SolverScratch& scratch, Real tolerance, Workers& workers) {
+  const Vec3* x = cloth.state.position.data();
+  const Real* w = cloth.state.inverseMass.data();
+  const DistanceConstraint* stretch = cloth.rest.of(ConstraintKind::stretch).data();
+  const Real scale = (1.0 + tolerance) * (1.0 + tolerance);
+  std::atomic<bool> found{false};
+  for (const SolverScratch::LineFamily& lines : scratch.lines) {
+    if (lines.start.size() < 2) continue;
+    workers.runShared(lines.start.size() - 1, 8, [&](std::size_t first, std::size_t last, int) {
+      if (found.load(std::memory_order_relaxed)) return;
+      bool beyond = false;
+      for (std::size_t l = first; l < last; ++l) {
+        const DistanceConstraint* link = stretch + lines.firstLink(l);
+        for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {
+          const DistanceConstraint& c = link[k];
+          const Vec3 d = x[c.b] - x[c.a];
+          const Real r = c.restLength;
+          beyond |= glm::dot(d, d) > scale * (r * r) && w[c.a] + w[c.b] > 0.0;
+        }
+      }
+      if (beyond) found.store(true, std::memory_order_relaxed);
+    });
+    if (found.load()) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real alphaTilde, bool geometricStiffness,
+          Workers& workers, Real* looseLambda, const Extra& extra, const std::function<void()>& afterStep,
+          PartClock* parts) {
+  // Two Newton steps: rows, columns, rows, columns. One leaves enough of the linearisation's error
+  // that, where the cloth moves fast (a whipping hem), it grows from substep to substep; after two
+  // it does not (docs/performance.md). With geometric stiffness the first step is the full Newton
+  // step (which keeps kinks from growing) and the second the tridiagonal one (which only refines the
+  // lengths): taking both full costs 1.7 times as much on hang2 for no stiffer a cloth, unless the
+  // tethers are projected after each (docs/design.md).
+  const auto newtonStep = [&](bool full) {
+    step(cloth, scratch, stiffness, xpbd, alphaTilde, geometricStiffness, full, workers);
+    if (afterStep) afterStep();
+  };
+  newtonStep(true);
+  newtonStep(extra.bothFull);
+  int taken = 0;
+  while (taken < extra.steps && stretchedBeyond(cloth, scratch, extra.tolerance, workers)) {
+    newtonStep(true);
+    ++taken;
+  }
+  if (!scratch.looseStretch.empty()) {
+    PartClock untimed;
+    (parts ? *parts : untimed).time(Stage::looseLinks, [&] {
+      solveLoose(cloth, scratch, stiffness, xpbd, alphaTilde, looseLambda);
+    });
+  }
+  return taken;
+}
+
+}  // namespace drape::sim::lines
+
+namespace drape::sim {
+
+int stiffSolveLanes() { return lines::cpuHasAvx() ? 8 : 4; }
+
+}  // namespace drape::sim

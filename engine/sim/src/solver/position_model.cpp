@@ -1,0 +1,485 @@
+#include "solver/position_model.hpp"
+
+#include "drape/sim/metrics.hpp"
+
+#include "solver/aerodynamics.hpp"
+#include "solver/bending.hpp"
+#include "collision/contacts.hpp"
+#include "solver/distance_wide.hpp"
+#include "solver/lines.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <functional>
+
+#include <glm/geometric.hpp>
+
+#if defined(__SSE2__) && defined(__x86_64__)
+#include <emmintrin.h>
+#endif
+
+namespace drape::sim::position {
+
+namespace {
+// (1 - e^{-kh}) / (kh), the weight of a constant acceleration in the damped Verlet step; 1 at k = 0.
+Real relaxation(Real kh) { return kh > 0.0 ? -std::expm1(-kh) / kh : 1.0; }
+}  // namespace
+
+void startHistory(Cloth& cloth, Vec3 acceleration, Real k, Real h) {
+  ParticleState& s = cloth.state;
+  const Real kh = k * h;
+  const auto backFor = [&](Vec3 v0) {
+    // Exact displacement over [0, h] of du/dt = a - k u, u(0) = v0: a h^2 / 2 + v0 h when k = 0.
+    const Vec3 displacement = kh > 0.0 ? acceleration / k * h + (v0 - acceleration / k) * (h * relaxation(kh))
+                                       : v0 * h + 0.5 * acceleration * h * h;
+    // Choose x_prev so that the first step, x1 = x0 + (x0 - x_prev) e^{-kh} + a h^2 relaxation, moves exactly that far.
+    return (displacement - acceleration * (h * h * relaxation(kh))) * std::exp(kh);
+  };
+  const Vec3 spin = cloth.settings.initialSpin;
+  const bool spins = glm::dot(spin, spin) > 0.0;
+  const Vec3 back = backFor(cloth.settings.initialVelocity);
+  const Vec3 centre = spins ? centreOfMass(cloth) : Vec3{0.0};
+  for (std::size_t i = 0; i < s.position.size(); ++i) {
+    if (s.inverseMass[i] == 0.0) {
+      s.previousPosition[i] = s.position[i];
+    } else if (spins) {
+      s.previousPosition[i] =
+          s.position[i] - backFor(cloth.settings.initialVelocity + glm::cross(spin, s.position[i] - centre));
+    } else {
+      s.previousPosition[i] = s.position[i] - back;
+    }
+  }
+}
+
+void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, std::vector<Vec3>& acceleration) {
+  const ParticleState& s = cloth.state;
+  std::fill(acceleration.begin(), acceleration.end(), Vec3{0.0});
+  const Real inverseH = 1.0 / h;
+  addWindPressure(
+      cloth.rest, s.position, s.inverseMass, air,
+      [&](ParticleIndex p) { return (s.position[p] - s.previousPosition[p]) * inverseH; }, acceleration);
+}
+
+namespace {
+
+// The guard's copy is written once a step and read only if the step goes bad: stored past the
+// caches where the CPU can (SSE2's streaming stores), it neither reads the lines it fills nor
+// pushes the cloth out of the cache. keptAll makes the stores seen before the workers join.
+void keep(Vec3* to, const Vec3& x) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  static_assert(sizeof(Vec3) == 3 * sizeof(double));
+  long long* out = reinterpret_cast<long long*>(to);
+  for (int k = 0; k < 3; ++k) _mm_stream_si64(out + k, std::bit_cast<long long>(x[k]));
+#else
+  *to = x;
+#endif
+}
+
+void keptAll() {
+#if defined(__SSE2__) && defined(__x86_64__)
+  _mm_sfence();
+#endif
+}
+
+}  // namespace
+
+void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
+               Workers& workers, Vec3* keepPosition) {
+  ParticleState& s = cloth.state;
+  // Exact for du/dt = a - k u over one substep: u' = u e^{-kh} + a h (1 - e^{-kh}) / (k h).
+  const Real kh = (world.solver.damping + world.air.drag) * h;
+  const Real decay = std::exp(-kh);
+  const Real relaxed = relaxation(kh);
+  const Vec3 constantAcceleration = world.gravity + world.air.drag * world.air.velocity;
+  const Real h2 = h * h * relaxed;
+  workers.run(
+      s.position.size(),
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t i = begin; i < end; ++i) {
+          if (keepPosition) keep(keepPosition + i, s.position[i]);
+          if (s.inverseMass[i] == 0.0) {
+            // Pinned or held: no force moves it, only the world does. It carries on as it was set to move
+            // (a finger sets x_prev one finger step behind); a pin has x_prev = x and stays exactly put.
+            const Vec3 x = s.position[i];
+            s.position[i] = x + (x - s.previousPosition[i]);
+            s.previousPosition[i] = x;
+            continue;
+          }
+          Vec3 acceleration = constantAcceleration;
+          if (extraAcceleration) acceleration += (*extraAcceleration)[i];
+          const Vec3 x = s.position[i];
+          s.position[i] = x + (x - s.previousPosition[i]) * decay + acceleration * h2;
+          s.previousPosition[i] = x;
+        }
+        if (keepPosition) keptAll();
+      },
+      4096);
+}
+
+void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inverseMass, const DistanceConstraint& c,
+                     Real stiffness) {
+  const Real wa = inverseMass[c.a], wb = inverseMass[c.b];
+  const Real wSum = wa + wb;
+  if (wSum == 0.0) return;
+  const Vec3 d = position[c.b] - position[c.a];
+  const Real length2 = glm::dot(d, d);
+  // Coincident particles give no direction to push along; a later sweep, after the neighbours
+  // have moved them apart, will.
+  if (!(length2 > 1e-20)) return;
+  const Real length = std::sqrt(length2);
+  const Vec3 correction = d * (stiffness * (length - c.restLength) / (length * wSum));
+  position[c.a] += wa * correction;
+  position[c.b] -= wb * correction;
+}
+
+// XPBD (Macklin et al. 2016, eq. 18): with C = |x_b - x_a| - r and alpha~ = compliance / h^2,
+// dlambda = (-C - alpha~ lambda) / (w_a + w_b + alpha~), x_a -= w_a dlambda n0, x_b += w_b dlambda n0,
+// n0 the link's direction at the substep's start (alongStart).
+void projectCompliant(std::vector<Vec3>& position, const std::vector<Vec3>& start, const std::vector<Real>& inverseMass,
+                      const DistanceConstraint& c, Real alphaTilde, Real& lambda) {
+  const Real wa = inverseMass[c.a], wb = inverseMass[c.b];
+  const Real denominator = wa + wb + alphaTilde;
+  if (denominator == 0.0) return;
+  const Vec3 d = position[c.b] - position[c.a];
+  const Real length2 = glm::dot(d, d);
+  if (!(length2 > 1e-20)) return;
+  const Real length = std::sqrt(length2);
+  const Real deltaLambda = (-(length - c.restLength) - alphaTilde * lambda) / denominator;
+  lambda += deltaLambda;
+  const Vec3 n = alongStart(d / length, start[c.a], start[c.b], lambda, wa + wb, c.restLength);
+  position[c.a] -= n * (wa * deltaLambda);
+  position[c.b] += n * (wb * deltaLambda);
+}
+
+namespace {
+
+// Onto the ball of radius r around c, if outside it.
+Vec3 intoBall(Vec3 x, Vec3 c, Real r) {
+  const Vec3 d = x - c;
+  const Real length2 = glm::dot(d, d);
+  if (length2 <= r * r) return x;
+  return c + d * (r / std::sqrt(length2));
+}
+
+// The line through two pins: consecutive particles mostly share their pins, so it is worked out
+// once per pair met.
+struct PinAxis {
+  ParticleIndex a = ~ParticleIndex{0}, b = ~ParticleIndex{0};
+  Vec3 n{0.0};  // unit, from a to b
+  Real distance = 0.0;
+  Real halfInverse = 0.0;  // 1 / (2 distance); 0 where the pins coincide
+  void update(ParticleIndex pinA, ParticleIndex pinB, Vec3 xa, Vec3 xb) {
+    if (pinA == a && pinB == b) return;
+    a = pinA;
+    b = pinB;
+    const Vec3 axis = xb - xa;
+    distance = glm::length(axis);
+    n = distance > 0.0 ? axis / distance : Vec3{0.0};
+    halfInverse = distance > 0.0 ? 0.5 / distance : 0.0;
+  }
+};
+
+// Whether along / sqrt(length2) >= t / r (a direction within the cone around the axis whose cosine
+// is t / r), without the square root.
+bool withinCone(Real along, Real length2, Real t, Real r) {
+  const Real lhs = along * along * r * r, rhs = t * t * length2;
+  return t >= 0.0 ? along >= 0.0 && lhs >= rhs : along >= 0.0 || lhs <= rhs;
+}
+
+// The nearest point to x within both balls (Euclidean projection onto their intersection, which
+// is never empty for tethers: the rest shape lies in it). Projecting onto one ball and then the
+// other instead converges slowly where the balls barely overlap, as they do along an edge between
+// two pins (the radii add up to the pins' distance): that edge then sags. Most particles of a
+// hanging sheet are inside both balls or on the circle where the spheres meet: both cost no more
+// than two square roots.
+Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
+  const Vec3 fromA = x - a, fromB = x - b;
+  const Real la2 = glm::dot(fromA, fromA), lb2 = glm::dot(fromB, fromB);
+  const bool inA = la2 <= ra * ra, inB = lb2 <= rb * rb;
+  if (inA && inB) return x;
+  const Real distance = axis.distance;
+  if (!(distance > 0.0)) {  // the pins coincide: the smaller ball
+    return ra <= rb ? intoBall(x, a, ra) : intoBall(x, b, rb);
+  }
+  // One ball inside the other (a pin carried towards the other): the lens is the inner ball. The
+  // cones below would clamp to a single ray and let a particle on the axis through to the outer
+  // sphere. (Told from the radii: along an edge between two pins the balls touch from outside,
+  // ra + rb = distance, and that case belongs to the circle.)
+  if (distance + rb <= ra) return intoBall(x, b, rb);
+  if (distance + ra <= rb) return intoBall(x, a, ra);
+  const Vec3 n = axis.n;
+  // The spheres meet in the plane at tA from a along n (at tB from b back along it). The part of
+  // sphere A inside ball B is the cone of directions from a whose cosine with n is at least
+  // tA / ra; x projects onto it, radially, when its own direction from a is in that cone. Likewise
+  // for B, along -n. Otherwise the nearest point is on the circle where the spheres meet. (Where
+  // one projection lands inside the other ball it is the nearest point of the lens, as for any
+  // intersection of convex sets.)
+  const Real along = glm::dot(fromA, n);  // signed: negative where the particle is beyond pin a
+  const Real tA = std::clamp((distance * distance + ra * ra - rb * rb) * axis.halfInverse, -ra, ra);
+  const Real tB = std::clamp((distance * distance + rb * rb - ra * ra) * axis.halfInverse, -rb, rb);
+  if (!inA && withinCone(along, la2, tA, ra)) return a + fromA * (ra / std::sqrt(la2));
+  if (!inB && withinCone(distance - along, lb2, tB, rb)) return b + fromB * (rb / std::sqrt(lb2));
+  const Real rho = std::sqrt(std::max(ra * ra - tA * tA, 0.0));
+  const Vec3 centre = a + n * tA;
+  const Vec3 off = fromA - n * along;
+  const Real offLength = glm::length(off);
+  // On the axis every point of the circle is as near; any is as good as another.
+  if (!(offLength > 1e-15 * (rho + distance))) return centre;
+  return centre + off * (rho / offLength);
+}
+
+// The tethered particles [begin, end) (counted over the runs, in order). A tether holds while its
+// pin is pinned (not let go) and nothing holds its particle (a finger then decides where it is).
+// A particle is never a pin while it is projected (its inverse mass is not 0), so each one reads
+// and writes only its own position.
+void projectTethers(ParticleState& s, const SolverScratch::Tethers& tethers, std::size_t begin, std::size_t end) {
+  const std::vector<SolverScratch::Tethers::Run>& runs = tethers.run;
+  std::size_t r = static_cast<std::size_t>(
+      std::upper_bound(runs.begin(), runs.end(), begin, [](std::size_t i, const auto& run) { return i < run.before; }) -
+      runs.begin() - 1);
+  const Real* w = s.inverseMass.data();
+  Vec3* x = s.position.data();
+  PinAxis axis;  // pins do not move while tethers are projected
+  for (; r < runs.size() && runs[r].before < end; ++r) {
+    const SolverScratch::Tethers::Run& run = runs[r];
+    const ParticleIndex* pin = tethers.pin.data() + run.pins;
+    const std::size_t from = std::max(begin, std::size_t{run.before}) - run.before;
+    const std::size_t to = std::min(end, std::size_t{run.before} + run.count) - run.before;
+    bool allPinned = true;
+    for (std::uint32_t j = 0; j < run.pinCount; ++j) allPinned = allPinned && w[pin[j]] == 0.0;
+    if (run.pinCount == 2 && allPinned) {
+      const Vec3 a = x[pin[0]], b = x[pin[1]];
+      axis.update(pin[0], pin[1], a, b);
+      for (std::size_t i = from; i < to; ++i) {
+        const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
+        if (w[particle] == 0.0) continue;
+        const RestReal* length = tethers.length.data() + run.lengths + 2 * i;
+        x[particle] = intoLens(x[particle], a, length[0], b, length[1], axis);
+      }
+      continue;
+    }
+    for (std::size_t i = from; i < to; ++i) {
+      const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
+      if (w[particle] == 0.0) continue;
+      const RestReal* length = tethers.length.data() + run.lengths + i * run.pinCount;
+      for (std::uint32_t j = 0; j < run.pinCount; ++j) {
+        if (w[pin[j]] == 0.0) x[particle] = intoBall(x[particle], x[pin[j]], length[j]);
+      }
+    }
+  }
+}
+
+// Constraints [begin, end) of one kind, in order, as projectDistance each.
+void projectRange(ParticleState& s, const DistanceConstraint* constraints, std::size_t begin, std::size_t end,
+                  Real stiffness) {
+  for (std::size_t k = begin; k < end; ++k) projectDistance(s.position, s.inverseMass, constraints[k], stiffness);
+}
+
+void projectCompliantRange(ParticleState& s, const DistanceConstraint* constraints, Real* lambda, std::size_t begin,
+                           std::size_t end, Real alphaTilde) {
+  for (std::size_t k = begin; k < end; ++k)
+    projectCompliant(s.position, s.previousPosition, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
+}
+
+// A fabric's bend stencils, in order (XPBD on the vector constraint C = sum k_j (x_j - x_0), which is
+// linear in the positions: dlambda = (-C - alpha~ lambda) / (sum w_j k_j^2 + alpha~),
+// x_j += w_j k_j dlambda, with alpha~ = 1 / (B h^2)).
+void projectBending(ParticleState& s, const std::vector<BendStencil>& stencils, std::vector<Vec3>& lambda,
+                    Real alphaTilde) {
+  Vec3* x = s.position.data();
+  const Real* w = s.inverseMass.data();
+  for (std::size_t i = 0; i < stencils.size(); ++i) {
+    const BendStencil& b = stencils[i];
+    Real weight = 0.0;
+    Vec3 C{0.0};
+    const Vec3 centre = x[b.v[0]];
+    for (int j = 0; j < 5; ++j) {
+      const Real k = b.k[j];
+      weight += w[b.v[j]] * k * k;
+      if (j > 0) C += k * (x[b.v[j]] - centre);
+    }
+    if (weight == 0.0) continue;
+    const Vec3 delta = (-C - alphaTilde * lambda[i]) / (weight + alphaTilde);
+    lambda[i] += delta;
+    for (int j = 0; j < 5; ++j) x[b.v[j]] += (w[b.v[j]] * Real(b.k[j])) * delta;
+  }
+}
+
+Real bendingAlphaTilde(const Cloth& cloth, Real h) { return 1.0 / (cloth.settings.fabric->bendingRigidity * h * h); }
+
+// A fabric's bend stencils: all at once where their block is narrow enough to factor (bending.hpp),
+// else one after another.
+void bend(Cloth& cloth, Real h, SolverScratch& scratch) {
+  const Real alphaTilde = bendingAlphaTilde(cloth, h);
+  if (scratch.bendingFactor.usable) {
+    bending::project(scratch.bendingFactor, cloth.state, cloth.rest.bending, scratch.bendingLambda, alphaTilde);
+  } else {
+    projectBending(cloth.state, cloth.rest.bending, scratch.bendingLambda, alphaTilde);
+  }
+}
+
+}  // namespace
+
+namespace {
+
+Stage partOf(ConstraintKind kind) {
+  switch (kind) {
+    case ConstraintKind::stretch: return Stage::stretch;
+    case ConstraintKind::shear: return Stage::shear;
+    case ConstraintKind::bend: return Stage::bend;
+  }
+  return Stage::stretch;
+}
+
+// The seed's sweep: a fabric's bend stencils, then every kind in order (stretch, shear, bend), each
+// constraint after the one before it in the order the cloth lists them, then the tethers. One thread.
+void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, PartClock& parts) {
+  ParticleState& s = cloth.state;
+  const bool xpbd = solver.xpbd || cloth.settings.fabric;
+  // A fabric's bending first: the sweep ends with what the eye sees most, the cloth's length.
+  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, h, scratch); });
+  for (ConstraintKind kind : kConstraintKinds) {
+    const KindMaterial& material = cloth.settings.material(kind);
+    if (material.stiffness == 0.0) continue;
+    const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
+    parts.time(partOf(kind), [&] {
+      if (xpbd) {
+        projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
+                              constraints.size(), material.compliance / (h * h));
+      } else {
+        projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
+      }
+    });
+  }
+  if (!scratch.tethers.empty()) {
+    parts.time(Stage::tethers, [&] { projectTethers(s, scratch.tethers, 0, scratch.tethers.particles()); });
+  }
+}
+
+// The fast sweep (solver.lines): tethers first, then bend and shear in batches shared among the
+// workers, then the stretch constraints a line at a time, last, so that a sweep ends with what
+// matters most to the eye, the cloth's length. With solver.tethersBetweenSteps the tethers are
+// projected again after each of the lines' Newton steps; with solver.extraLineSteps the lines take
+// more steps while a link is over solver.stretchTolerance (lines::solve).
+void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, Workers& workers,
+                    PartClock& parts) {
+  ParticleState& s = cloth.state;
+  const auto tethers = [&] {
+    if (scratch.tethers.empty()) return;
+    // Shared out in blocks: the particles near the pins cost more (they are on a sphere, and the
+    // rest inside both balls); on hang2 256 the first half of the sheet took 2.6 times as long as
+    // the second.
+    parts.time(Stage::tethers, [&] {
+      workers.runShared(scratch.tethers.particles(), 512, [&](std::size_t begin, std::size_t end, int) {
+        projectTethers(s, scratch.tethers, begin, end);
+      });
+    });
+  };
+  tethers();
+  const bool xpbd = solver.xpbd || cloth.settings.fabric;
+  // A fabric's bend stencils on one thread (not yet in batches).
+  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, h, scratch); });
+  for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
+    const std::size_t kindIndex = static_cast<std::size_t>(kind);
+    const KindMaterial& material = cloth.settings.material(kind);
+    if (material.stiffness == 0.0) continue;
+    const Real alphaTilde = material.compliance / (h * h);
+    if (kind == ConstraintKind::stretch) {
+      const Real stiffness = xpbd ? 1.0 : material.stiffness;
+      Real* looseLambda = scratch.lambda[kindIndex].data();
+      // With the tethers between the line steps both steps are full and the tethers follow each,
+      // the last too: they keep the edges beside a pin from being pulled long by the last step.
+      const bool between = solver.tethersBetweenSteps;
+      parts.time(Stage::stretch, [&] {
+        scratch.extraLineSteps +=
+            lines::solve(cloth, scratch, stiffness, xpbd, alphaTilde, solver.geometricStiffness, workers, looseLambda,
+                         {between, solver.extraLineSteps, solver.stretchTolerance},
+                         between ? std::function<void()>(tethers) : nullptr, &parts);
+      });
+      continue;
+    }
+    const DistanceConstraint* constraints = cloth.rest.of(kind).data();
+    Real* lambda = scratch.lambda[kindIndex].data();
+    // A batch's constraints (no two share a particle) four at a time where the CPU has AVX.
+    const auto body = [&](std::size_t begin, std::size_t end, bool batch) {
+      if (xpbd) {
+        projectCompliantRange(s, constraints, lambda, begin, end, alphaTilde);
+        return;
+      }
+      if (batch && lines::cpuHasAvx()) {
+        static_assert(sizeof(Vec3) == 3 * sizeof(double), "positions are read as x, y, z doubles");
+        begin = projectBatchWide(reinterpret_cast<double*>(s.position.data()), s.inverseMass.data(), constraints, begin,
+                                 end, material.stiffness);
+      }
+      projectRange(s, constraints, begin, end, material.stiffness);
+    };
+    const std::vector<std::uint32_t>& start = scratch.batchStart[kindIndex];
+    parts.time(partOf(kind), [&] {
+      for (std::size_t b = 0; b + 1 < start.size(); ++b) {
+        const std::size_t begin = start[b], end = start[b + 1];
+        if (scratch.sequentialTail[kindIndex] && b + 2 == start.size()) {
+          body(begin, end, false);  // its constraints may share particles: one thread, one after another
+        } else {
+          // Blocks of up to 2048 constraints, at least four a thread (hang2 64's batches hold 2000).
+          const std::size_t block =
+              std::clamp<std::size_t>((end - begin) / (4 * static_cast<std::size_t>(workers.threads())), 256, 2048);
+          workers.runShared(end - begin, block,
+                            [&](std::size_t first, std::size_t last, int) { body(begin + first, begin + last, true); });
+        }
+      }
+    });
+  }
+}
+
+}  // namespace
+
+void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, bool contacts,
+                        Workers& workers, PartClock& parts) {
+  if (solver.xpbd || cloth.settings.fabric) {
+    for (ConstraintKind kind : kConstraintKinds) {
+      scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
+    }
+    scratch.bendingLambda.assign(cloth.rest.bending.size(), Vec3{0.0});
+    if (!cloth.rest.bending.empty()) {
+      bending::prepare(scratch.bendingFactor, cloth.rest.bending, cloth.state.inverseMass, bendingAlphaTilde(cloth, h));
+    }
+    if (solver.lines) {
+      for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.slots(), 0.0);
+    }
+  }
+  if (solver.lines && solver.geometricStiffness) lines::beginSubstep(scratch);
+  for (int iteration = 0; iteration < solver.iterations; ++iteration) {
+    if (solver.lines) {
+      sweepInBatches(cloth, solver, h, scratch, workers, parts);
+    } else {
+      sweepInOrder(cloth, solver, h, scratch, parts);
+    }
+    if (contacts) parts.time(Stage::contactPlanes, [&] { contact::project(cloth, scratch); });
+  }
+}
+
+void dampConstraints(Cloth& cloth) {
+  ParticleState& s = cloth.state;
+  for (ConstraintKind kind : kConstraintKinds) {
+    const Real damping = cloth.settings.material(kind).damping;
+    if (damping == 0.0) continue;
+    for (const DistanceConstraint& c : cloth.rest.of(kind)) {
+      const Real wa = s.inverseMass[c.a], wb = s.inverseMass[c.b];
+      const Real wSum = wa + wb;
+      if (wSum == 0.0) continue;
+      const Vec3 d = s.position[c.b] - s.position[c.a];
+      const Real length = glm::length(d);
+      if (!(length > 1e-10)) continue;
+      const Vec3 n = d / length;
+      // relative displacement over the substep along n (velocity times h)
+      const Real relative =
+          glm::dot((s.position[c.b] - s.previousPosition[c.b]) - (s.position[c.a] - s.previousPosition[c.a]), n);
+      const Real impulse = damping * relative / wSum;
+      s.previousPosition[c.a] -= (wa * impulse) * n;
+      s.previousPosition[c.b] += (wb * impulse) * n;
+    }
+  }
+}
+
+}  // namespace drape::sim::position
