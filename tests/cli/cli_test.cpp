@@ -513,6 +513,7 @@ TEST_F(Cli, BenchRefusesBadValuesWithOneLine) {
   expectOneLineError(run("bench --extra-line-steps 101"), 2, "--extra-line-steps");
   expectOneLineError(run("bench --touch-sizes 1"), 2, "--touch-sizes");
   expectOneLineError(run("bench --touch-budget 0"), 2, "--touch-budget");
+  expectOneLineError(run("bench --touch-cases 'desk crumple,desk crumpel'"), 2, "desk crumpel");
   EXPECT_FALSE(fs::exists(file("p")));
 }
 

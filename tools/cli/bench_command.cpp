@@ -123,6 +123,14 @@ int bench(const BenchArguments& input) {
     for (int n : arguments.touchSizes) {
       if (n < 2) throw scene::InputError("--touch-sizes: " + std::to_string(n) + " is not 0 or between 2 and 1024");
     }
+    std::vector<TouchCase> cases;
+    for (const TouchCase& c : touchCases()) {
+      if (arguments.touchCases.empty() || std::ranges::count(arguments.touchCases, c.name)) cases.push_back(c);
+    }
+    for (const std::string& name : arguments.touchCases) {
+      if (std::ranges::none_of(cases, [&](const TouchCase& c) { return c.name == name; }))
+        throw scene::InputError("--touch-cases: no case is called \"" + name + "\"");
+    }
     // Every scene is read before anything runs: a bad name fails at once.
     std::vector<scene::Scene> scenes;
     for (const std::string& name : arguments.scenes) {
@@ -190,7 +198,7 @@ int bench(const BenchArguments& input) {
     // The scenes people touch, smallest first: one run each (touch_bench.hpp).
     std::vector<TouchRow> touched;
     for (int n : arguments.touchSizes) {
-      for (const TouchCase& c : touchCases()) {
+      for (const TouchCase& c : cases) {
         for (int t : arguments.threads) {
           touched.push_back(playTouchCase(c, n, t, arguments.touchBudget));
           if (!arguments.quiet) {

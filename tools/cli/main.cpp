@@ -173,6 +173,10 @@ int main(int argc, char** argv) {
       ->transform(kDecimal)
       ->check(CLI::Range(0, 1024));
   benchCommand
+      ->add_option("--touch-cases", benchArguments.touchCases,
+                   "Which of the scenes people touch to play, by name (\"desk crumple,desk tear\"; default every one)")
+      ->delimiter(',');
+  benchCommand
       ->add_option("--touch-budget", benchArguments.touchBudget,
                    "Seconds of stepping a touch case may take; it stops there and says how far it got (default 60)")
       ->check(CLI::Range(0.001, 1.0e6));

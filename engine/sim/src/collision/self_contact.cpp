@@ -32,6 +32,8 @@ constexpr Real kCoincident = 1e-12;
 // pushes nothing: a free corner of weight 0.004 in a triangle whose other corners and the vertex
 // fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair apart instead.
 constexpr Real kLeverage = 0.25;
+// A pair's separation where nothing is proven.
+constexpr float kUnproven = -std::numeric_limits<float>::infinity();
 // How many times its rest size a triangle or edge may be stretched and still take part (longer
 // than its cloth at rest too, it takes none: findPairs).
 constexpr Real kTorn = 10.0;
@@ -139,6 +141,19 @@ glm::vec3 above(const Vec3& x) {
           std::nextafter(toFloat(x.z), INFINITY)};
 }
 
+// A point's largest coordinate, in magnitude (infinite where one is NaN: no room is then enough).
+Real largest(const Vec3& x) {
+  const Real m = std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)});
+  return std::isnan(x.x + x.y + x.z) ? std::numeric_limits<Real>::infinity() : m;
+}
+
+// The float at or below v (a proof's separation kept in single precision must not grow).
+float floatBelow(Real v) {
+  if (std::isnan(v)) return kUnproven;
+  const auto f = static_cast<float>(v);
+  return static_cast<Real>(f) > v ? std::nextafter(f, -INFINITY) : f;
+}
+
 bool overlap(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& otherLo, const glm::vec3& otherHi) {
   return lo.x <= otherHi.x && otherLo.x <= hi.x && lo.y <= otherHi.y && otherLo.y <= hi.y && lo.z <= otherHi.z &&
          otherLo.z <= hi.z;
@@ -151,13 +166,15 @@ std::size_t SelfContact::bytes() const {
   std::size_t total = b(clothOf_) + b(rest_) + b(clothSize_) + b(triangles_) + b(edges_) + b(edgeTriangles_) +
                       b(vertexStart_) + b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) +
                       b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
-                      b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) +
-                      b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) +
-                      b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_);
+                      b(reach_) + b(runNear_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) +
+                      b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) +
+                      b(which0_) + b(whichX_) + b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
   for (const std::vector<Pair>& found : found_) total += b(found);
-  for (const std::vector<Contact>& measured : measured_) total += b(measured);
+  for (const std::vector<std::uint64_t>& found : scanTests_) total += b(found);
+  for (const auto& measured : scanContacts_) total += b(measured);
+  total += b(scanTested_);
   return total;
 }
 
@@ -529,7 +546,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (c[0] == v || c[1] == v || c[2] == v) continue;
               const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
               if (apart(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) continue;
-              vertexTriangle.push_back({v, t, kFar, false, false});
+              vertexTriangle.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
             }
           }
         };
@@ -552,7 +569,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
               const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
               if (apart(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
-              edgeEdge.push_back({std::min(e, f), std::max(e, f), kFar, true, false});
+              edgeEdge.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
             }
           }
         }
@@ -566,6 +583,8 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     for (std::size_t b = 0; b < blocks; ++b)
       pairs_.insert(pairs_.end(), found_[2 * b + k].begin(), found_[2 * b + k].end());
   }
+  // The blocks' lists go once joined: kept, they held as much again as the pairs.
+  for (std::vector<Pair>& found : found_) std::vector<Pair>().swap(found);
   for (const std::int64_t compared : boxTests_) tests += compared;
   stats_.boxTests += tests;
 }
@@ -624,7 +643,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
     if (c[0] == v || c[1] == v || c[2] == v) return;
     const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
     if (apartBoxes(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) return;
-    pairs_.push_back({v, t, kFar, false, true});
+    pairs_.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
   };
   // A stray vertex against every triangle; a triangle with a stray corner against every vertex
   // but the stray ones (paired from their side); an edge with a stray end against every edge, and
@@ -657,7 +676,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
         if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
         const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
         if (apartBoxes(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
-        pairs_.push_back({std::min(e, f), std::max(e, f), kFar, true, true});
+        pairs_.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
       }
     });
   }
@@ -694,21 +713,20 @@ bool SelfContact::keepPairs(const std::vector<std::uint32_t>* candidates, Real d
   return true;
 }
 
-bool SelfContact::stillFar(const Pair& p) const {
-  const Real slack = 0.25 * (measuredDistance_ - kProofMargin);
-  if (!(slack > 0.0)) return false;
+Real SelfContact::proven(const Pair& p) const {
+  // Along a fixed line, each corner's position moves by no more than the corner does: each side's
+  // reach along it grows by its farthest-gone corner's reach_, and the gap shrinks by the two.
   const std::array<std::uint32_t, 4> v = corners(p);
-  for (int k = 0; k < 4; ++k) {
-    const Vec3 d = x_[v[k]] - xMeasured_[v[k]];
-    if (!(glm::dot(d, d) <= slack * slack)) return false;
-  }
-  return true;
+  const int split = p.edges ? 2 : 1;
+  Real most[2] = {0.0, 0.0};
+  for (int k = 0; k < 4; ++k) most[k < split ? 0 : 1] = std::max(most[k < split ? 0 : 1], reach_[v[k]]);
+  return static_cast<Real>(p.apart) - most[0] - most[1];
 }
 
-bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
+Real SelfContact::separation(const Pair& p) const {
   // Along the line between the two primitives' centres at x0: the hull of one's corners at x0 and
   // at x against the other's. Apart there, they are apart all along the straight paths from x0 to
-  // x (each corner's path lies between its two ends), by more than `margin`.
+  // x (each corner's path lies between its two ends).
   const std::array<std::uint32_t, 4> v = corners(p);
   const Vec3 axis = p.edges ? (x0_[v[0]] + x0_[v[1]]) * 0.5 - (x0_[v[2]] + x0_[v[3]]) * 0.5
                             : x0_[v[0]] - (x0_[v[1]] + x0_[v[2]] + x0_[v[3]]) * (1.0 / 3.0);
@@ -724,21 +742,20 @@ bool SelfContact::apartAlongCentres(const Pair& p, Real margin) const {
     lo[side] = std::min({lo[side], a, b});
     hi[side] = std::max({hi[side], a, b});
   }
-  // Along the axis as it is (not of unit length): the margin scaled by its length, and room for
-  // the rounding of the dot products, which grows with the coordinates.
+  // The rounding of the dot products grows with the coordinates, not with the projections: room for
+  // the largest coordinate of any particle (coordinates_).
+  const Real scale = coordinates_ * (std::abs(axis.x) + std::abs(axis.y) + std::abs(axis.z));
+  // Along the axis as it is (not of unit length): the gap over its length, less room for rounding.
   const Real length = glm::length(axis);
-  Real scale = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    scale =
-        std::max({scale, glm::dot(glm::abs(x0_[v[k]]), glm::abs(axis)), glm::dot(glm::abs(x_[v[k]]), glm::abs(axis))});
-  }
-  const Real room = margin * length + 1e-12 * scale;
-  // Not apart unless every figure is finite (min and max pass a NaN by).
-  if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + room)) return false;
-  return length > 0.0 && (hi[1] + room < lo[0] || hi[0] + room < lo[1]);
+  const Real gap = std::max(lo[0] - hi[1], lo[1] - hi[0]) - 1e-12 * scale;
+  const Real apart = gap / length;
+  // Nothing unless every figure is finite (min and max pass a NaN by).
+  if (!(length > 0.0) || !std::isfinite(apart + lo[0] + hi[0] + lo[1] + hi[1]))
+    return -std::numeric_limits<Real>::infinity();
+  return apart;
 }
 
-SelfContact::Contact SelfContact::measure(const Pair& pair, Real distance) const {
+SelfContact::Contact SelfContact::measure(Pair& pair, Real distance) const {
   const std::array<std::uint32_t, 4> v = corners(pair);
   Contact contact;
   const Weights weights = pair.edges ? edgeEdgeWeights(x0_[v[0]], x0_[v[1]], x0_[v[2]], x0_[v[3]])
@@ -753,11 +770,18 @@ SelfContact::Contact SelfContact::measure(const Pair& pair, Real distance) const
   contact.normal = contact.gap0 > kCoincident ? gap / contact.gap0 : Vec3{0.0};
   contact.push = 0.0;
   // How far apart the pair keeps: `distance`, or less for parts of one cloth closer than that at rest.
+  // (Which it is, the pair keeps from its first measure: the rest shape and the distance stay while
+  // it does, as a change of either finds the pairs again.)
   contact.target = distance;
-  if (clothOf_[v[0]] == clothOf_[v[2]]) {
-    const Weights rest = pair.edges ? edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])
-                                    : vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
-    contact.target = std::min(distance, glm::length(between(rest, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])));
+  if (pair.rest != kRestApart) {
+    Real rest = distance;
+    if (clothOf_[v[0]] == clothOf_[v[2]]) {
+      const Weights w = pair.edges ? edgeEdgeWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]])
+                                   : vertexTriangleWeights(rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]);
+      rest = glm::length(between(w, rest_[v[0]], rest_[v[1]], rest_[v[2]], rest_[v[3]]));
+    }
+    pair.rest = rest < distance ? kRestNear : kRestApart;
+    contact.target = std::min(distance, rest);
   }
   return contact;
 }
@@ -766,49 +790,60 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
   // Each pair's closest points at x0, the direction between them, and how far apart they keep;
   // except a pair apart by more than `distance` all through the substep (as the solve found it),
   // which no sweep pushes: it is marked far, and the fail-safe looks at it again at its end.
-  // Each thread measures its run of the pairs into its own list, numbering them from 0; the lists
-  // are joined in order, and each thread then numbers its run's contacts from where its list went.
-  const auto threads = static_cast<std::size_t>(workers.threads());
-  measured_.resize(threads);
-  for (std::vector<Contact>& measured : measured_) measured.clear();
-  xMeasured_ = x_;
-  measuredDistance_ = distance;
-  auto measureRun = [&](std::size_t begin, std::size_t end, int thread) {
-    std::vector<Contact> measured;  // (on the thread's stack while it is filled, as in findPairs)
-    measured.swap(measured_[static_cast<std::size_t>(thread)]);
-    for (std::size_t i = begin; i < end; ++i) {
-      Pair& pair = pairs_[i];
-      pair.refreshed = false;
-      if (apartAlongCentres(pair, distance)) {
-        pair.contact = kFar;
-      } else {
-        pair.contact = static_cast<std::uint32_t>(measured.size());
-        measured.push_back(measure(pair, distance));
-      }
-    }
-    measured_[static_cast<std::size_t>(thread)].swap(measured);
-  };
-  workers.run(pairs_.size(), measureRun, 1024);
-  // (The second loop cuts the pairs as the first did: as many, in as many runs.)
-  std::vector<std::size_t> offset(threads, 0);
-  contacts_.clear();
-  bool split = false;
-  for (std::size_t t = 0; t < threads; ++t) {
-    offset[t] = contacts_.size();
-    if (t > 0 && !measured_[t].empty()) split = true;
-    contacts_.insert(contacts_.end(), measured_[t].begin(), measured_[t].end());
-  }
-  if (split) {
+  // A pair kept from the last measure carries what was proven of it then: where that, less how far
+  // its corners went since (at x0 and now), still keeps it apart by more than `distance`, it is far
+  // without looking again; and what is left of the proof is what it carries on. The others are
+  // looked at along the line between their centres.
+  const std::size_t n = x_.size();
+  const bool carried = xMeasured_.size() == n;
+  reach_.resize(n);
+  coordinates_ = 0.0;
+  for (std::size_t i = 0; i < n; ++i) coordinates_ = std::max({coordinates_, largest(x0_[i]), largest(x_[i])});
+  if (carried) {
     workers.run(
-        pairs_.size(),
-        [&](std::size_t begin, std::size_t end, int thread) {
-          const auto from = static_cast<std::uint32_t>(offset[static_cast<std::size_t>(thread)]);
-          for (std::size_t i = begin; i < end; ++i) {
-            if (pairs_[i].contact != kFar) pairs_[i].contact += from;
-          }
+        n,
+        [&](std::size_t begin, std::size_t end, int) {
+          for (std::size_t i = begin; i < end; ++i) reachOf(static_cast<std::uint32_t>(i), true);
         },
         1024);
   }
+  // Two loops cut alike (as many pairs, in as many runs): the first tells each run's far pairs from
+  // its near ones and counts these; the second measures them into contacts_, each run's from where
+  // the runs before it end, in the pairs' order whatever the number of threads.
+  const auto threads = static_cast<std::size_t>(workers.threads());
+  std::vector<std::size_t>& near = runNear_;
+  near.assign(threads + 1, 0);
+  constexpr std::uint32_t kNear = 0;
+  workers.run(
+      pairs_.size(),
+      [&](std::size_t begin, std::size_t end, int thread) {
+        std::size_t count = 0;
+        for (std::size_t i = begin; i < end; ++i) {
+          Pair& pair = pairs_[i];
+          Real apart = carried && pair.apart != kUnproven ? proven(pair) : -std::numeric_limits<Real>::infinity();
+          if (!(apart > distance)) apart = separation(pair);
+          pair.apart = floatBelow(apart);
+          pair.contact = apart > distance ? kFar : kNear;
+          count += pair.contact == kNear;
+        }
+        near[static_cast<std::size_t>(thread) + 1] = count;
+      },
+      1024);
+  for (std::size_t t = 0; t < threads; ++t) near[t + 1] += near[t];
+  contacts_.resize(near[threads]);
+  workers.run(
+      pairs_.size(),
+      [&](std::size_t begin, std::size_t end, int thread) {
+        auto next = static_cast<std::uint32_t>(near[static_cast<std::size_t>(thread)]);
+        for (std::size_t i = begin; i < end; ++i) {
+          Pair& pair = pairs_[i];
+          if (pair.contact == kFar) continue;
+          pair.contact = next;
+          contacts_[next++] = measure(pair, distance);
+        }
+      },
+      1024);
+  xMeasured_ = x_;  // (what the pairs now carry was proven of the particles as they are)
 }
 
 void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch) {
@@ -1040,40 +1075,89 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
   bool everyPair = true;  // test every pair this round (the first, or the pairs were found again)
   for (std::uint32_t round = 1;; ++round) {
     tests.clear();
-    for (Pair& p : pairs_) {
-      if (!everyPair) {
-        // After the first round, only pairs whose tests a zone's move changed.
-        bool moved = false;
-        eachTest(p, [&](std::uint32_t s, std::uint32_t t) { moved = moved || triangleMoved_[s] || triangleMoved_[t]; });
-        if (!moved) continue;
+    // How far each particle went since the pairs were measured (those a zone moved, after the
+    // first round, unless the pairs were measured again).
+    // And the largest coordinate: the contacts' sweep and a zone's move may take a particle past it.
+    if (everyPair) {
+      reach_.resize(n);
+      for (std::uint32_t i = 0; i < n; ++i) {
+        reachOf(i, false);
+        coordinates_ = std::max(coordinates_, largest(x_[i]));
       }
-      // The largest relative motion of a corner of one against a corner of the other.
-      Real m = 0.0;
-      const int split = p.edges ? 2 : 1;
-      const std::array<std::uint32_t, 4> v = corners(p);
-      for (int i = 0; i < split; ++i) {
-        for (int j = split; j < 4; ++j) {
-          const Vec3 d = (x_[v[i]] - x0_[v[i]]) - (x_[v[j]] - x0_[v[j]]);
-          m = std::max(m, glm::dot(d, d));
-        }
+    } else {
+      for (const std::uint32_t i : members) {
+        reachOf(i, false);
+        coordinates_ = std::max(coordinates_, largest(x_[i]));
       }
-      if (p.contact == kFar) {
-        // Far when the solve began: still apart along the line between their centres, or looked
-        // at as any other pair. Apart there by more than the distance when measured, they still
-        // are by more than kProofMargin while no corner has moved a quarter of the difference
-        // since (each side's reach along the line grows by its move; the quarter leaves room for
-        // rounding), which is cheaper to tell.
-        if ((!p.refreshed && stillFar(p)) || apartAlongCentres(p, kProofMargin)) continue;
-        p.contact = static_cast<std::uint32_t>(contacts_.size());
-        contacts_.push_back(measure(p, distance));
+    }
+    // The pairs, in parallel: each run's tests and the far pairs it measured in its own lists,
+    // joined in the runs' order (the same whatever the number of threads).
+    const auto threads = static_cast<std::size_t>(workers.threads());
+    scanTests_.resize(threads);
+    scanContacts_.resize(threads);
+    scanTested_.assign(threads, 0);
+    workers.run(
+        pairs_.size(),
+        [&](std::size_t begin, std::size_t end, int thread) {
+          const auto t = static_cast<std::size_t>(thread);
+          std::vector<std::uint64_t> found;  // (on the thread's stack while it is filled, as in findPairs)
+          std::vector<std::pair<std::uint32_t, Contact>> measured;
+          found.swap(scanTests_[t]);
+          measured.swap(scanContacts_[t]);
+          found.clear();
+          measured.clear();
+          std::int64_t tested = 0;
+          for (std::size_t i = begin; i < end; ++i) {
+            Pair& p = pairs_[i];
+            if (!everyPair) {
+              // After the first round, only pairs whose tests a zone's move changed.
+              bool moved = false;
+              eachTest(p, [&](std::uint32_t s, std::uint32_t u) {
+                moved = moved || triangleMoved_[s] || triangleMoved_[u];
+              });
+              if (!moved) continue;
+            }
+            // Proven apart all the way: by what the last measure proved, less how far its corners
+            // went since; along the line between the centres (a far pair, or a near one whose
+            // corners moved apart); or by the gap at x0 against the corners' relative motion.
+            if (p.apart != kUnproven && proven(p) > kProofMargin) continue;
+            const bool far = p.contact == kFar;
+            Real gap0;
+            if (far) {
+              if (apartAlongCentres(p, kProofMargin)) continue;
+              measured.push_back({static_cast<std::uint32_t>(i), measure(p, distance)});
+              gap0 = measured.back().second.gap0;
+            } else {
+              gap0 = contacts_[p.contact].gap0;
+            }
+            // The largest relative motion of a corner of one against a corner of the other.
+            Real m = 0.0;
+            const int split = p.edges ? 2 : 1;
+            const std::array<std::uint32_t, 4> v = corners(p);
+            for (int a = 0; a < split; ++a) {
+              for (int b = split; b < 4; ++b) {
+                const Vec3 d = (x_[v[a]] - x0_[v[a]]) - (x_[v[b]] - x0_[v[b]]);
+                m = std::max(m, glm::dot(d, d));
+              }
+            }
+            if (gap0 > std::sqrt(m) + kProofMargin || (!far && apartAlongCentres(p, kProofMargin))) continue;
+            ++tested;
+            eachTest(p, [&](std::uint32_t s, std::uint32_t u) {
+              found.push_back((static_cast<std::uint64_t>(std::min(s, u)) << 32) | std::max(s, u));
+            });
+          }
+          scanTests_[t].swap(found);
+          scanContacts_[t].swap(measured);
+          scanTested_[t] = tested;
+        },
+        1024);
+    for (std::size_t t = 0; t < threads; ++t) {
+      for (const auto& [i, contact] : scanContacts_[t]) {
+        pairs_[i].contact = static_cast<std::uint32_t>(contacts_.size());
+        contacts_.push_back(contact);
       }
-      // Proven apart all the way: by the gap at x0 against the relative motion, or (a pair near at
-      // x0 whose corners moved apart) along the line between the centres.
-      if (contacts_[p.contact].gap0 > std::sqrt(m) + kProofMargin || apartAlongCentres(p, kProofMargin)) continue;
-      ++stats_.tested;
-      eachTest(p, [&](std::uint32_t s, std::uint32_t t) {
-        tests.push_back((static_cast<std::uint64_t>(std::min(s, t)) << 32) | std::max(s, t));
-      });
+      tests.insert(tests.end(), scanTests_[t].begin(), scanTests_[t].end());
+      stats_.tested += scanTested_[t];
     }
     // Each pair of triangles once (pairs of primitives share them), in order.
     std::sort(tests.begin(), tests.end());

@@ -15,13 +15,17 @@
 //    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding), except
 //    where that would move a particle far more than the points part (kLeverage). A pair whose
 //    corners lie more than `distance` apart along the line between its centres all through the
-//    substep is far: not measured, not pushed (the fail-safe proves it apart by that line). Then
+//    substep is far: not measured, not pushed (the fail-safe proves it apart by that line). What
+//    was proven of a pair (how far apart, along a line) it keeps from one substep to the next, less
+//    how far its corners have gone since: a pair still proven far is not looked at again. Then
 //    Coulomb friction in position form on each pair that was pushed: the tangential part of its
 //    relative motion, removed up to `friction` times the push.
 // 3. Fail-safe. Along the straight path from x0 to x, two primitives at x0-distance g can only
 //    meet if their corners' relative motion m (the largest |dx_i - dx_j| between a corner of one
 //    and of the other) reaches g. A pair with m < g is proven apart, as is one whose corners' hulls
-//    over the substep lie apart along the line between its centres. For the others, the triangles
+//    over the substep lie apart along the line between its centres, or that its proof from the
+//    contacts' measure still keeps apart. The pairs are looked at in parallel, each thread's run
+//    in its own lists, joined in order. For the others, the triangles
 //    around them are tested exactly (intersections.hpp's test, on the 2^-24 m grid) at x and at x0,
 //    each pair of triangles once a round; where two of them intersect at x and did not at x0, their
 //    free corners join an impact zone, which moves rigidly from x0 by its mass-weighted mean motion
@@ -50,12 +54,12 @@
 #include <utility>
 #include <vector>
 
+#include "collision/exact_triangles.hpp"
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
-#include "collision/exact_triangles.hpp"
+#include "parallel/workers.hpp"
 #include "part_clock.hpp"
 #include "solver/solver_scratch.hpp"
-#include "parallel/workers.hpp"
 
 namespace drape::sim::contact {
 
@@ -86,11 +90,17 @@ class SelfContact {
     // Its contact (an index into contacts_), or kFar: apart by more than the distance as the solve
     // began, so not measured and not pushed.
     std::uint32_t contact;
+    // How far apart its two primitives were proven to be, m, along a line (the one between their
+    // centres when it was last looked along), while each corner stays where it was when the pairs
+    // were last measured (xMeasured_); as they move from there, the proof holds less by as far as
+    // each side's corners went (SelfContact::proven). -inf: nothing proven (a new pair).
+    float apart;
     bool edges;
-    // Listed by a refresh in the fail-safe, after the pairs were measured: not measured with them
-    // (so SelfContact::stillFar says nothing of it).
-    bool refreshed;
+    // Whether its two primitives lie at least the distance apart at rest (then they keep the
+    // distance; else as far as at rest): kRestUnknown until first measured.
+    std::uint8_t rest;
   };
+  static constexpr std::uint8_t kRestUnknown = 0, kRestApart = 1, kRestNear = 2;
   static constexpr std::uint32_t kFar = 0xffffffffu;
   // A pair measured at x0 (those not far): what the sweeps push along.
   struct Contact {
@@ -134,11 +144,25 @@ class SelfContact {
   void scatter(std::vector<Cloth>& cloths) const;
   void findPairs(Real distance, Real ahead, Workers& workers);
   void measurePairs(Real distance, Workers& workers);
-  Contact measure(const Pair& pair, Real distance) const;
-  bool apartAlongCentres(const Pair& pair, Real margin) const;
-  // A far pair none of whose corners has moved far enough since it was measured to bring it within
-  // kProofMargin along the line between its centres (what apartAlongCentres would find, sooner).
-  bool stillFar(const Pair& pair) const;
+  Contact measure(Pair& pair, Real distance) const;
+  // How far apart the pair's two sides lie along the line between its centres at x0, all along
+  // the straight paths from x0 to x (the hull of each side's corners at both ends), m, less room
+  // for rounding; -inf where they overlap there or a figure is not finite.
+  Real separation(const Pair& pair) const;
+  bool apartAlongCentres(const Pair& pair, Real margin) const { return separation(pair) > margin; }
+  // How far apart the pair is proven to be still, from what was proven when the pairs were last
+  // measured and how far its corners went since (reach_).
+  Real proven(const Pair& pair) const;
+  // reach_ of particle i, from its motion (x0 too, or x alone) against where it was measured.
+  void reachOf(std::uint32_t i, bool fromX0) {
+    const Vec3 d = x_[i] - xMeasured_[i];
+    Real r = glm::dot(d, d);
+    if (fromX0) {
+      const Vec3 d0 = x0_[i] - xMeasured_[i];
+      r = std::max(r, glm::dot(d0, d0));
+    }
+    reach_[i] = std::sqrt(r);
+  }
   void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
   void failSafe(Real distance, Workers& workers);
   // Of `candidates` (every particle where null), those not `margin` inside their boxes at x0 and
@@ -208,11 +232,15 @@ class SelfContact {
   std::vector<std::vector<Pair>> found_;  // per block of leaf pairs: vertex-triangle pairs, then edge-edge pairs
   std::vector<std::int64_t> boxTests_;    // per thread: primitive boxes compared
   std::vector<Pair> pairs_;
-  std::vector<Contact> contacts_;               // the pairs not far, in the pairs' order (then the fail-safe's)
-  std::vector<std::vector<Contact>> measured_;  // per thread, as measurePairs makes them
-  std::vector<std::uint32_t> active_;           // contacts the sweeps look at
-  std::vector<Vec3> xMeasured_;                 // x as the pairs were last measured
-  Real measuredDistance_ = 0.0;                 // the distance they were measured for
+  std::vector<Contact> contacts_;      // the pairs not far, in the pairs' order (then the fail-safe's)
+  std::vector<std::size_t> runNear_;   // measurePairs: where each run's contacts begin
+  std::vector<std::uint32_t> active_;  // contacts the sweeps look at
+  std::vector<Vec3> xMeasured_;        // x as the pairs were last measured
+  // Per particle: how far it has gone from xMeasured_ (now, and at x0 too where the measure asks).
+  std::vector<Real> reach_;
+  // The largest coordinate of any particle at x0 or now, as measurePairs began (the rounding room of
+  // separation grows with it).
+  Real coordinates_ = 0.0;
   // The fail-safe's impact zones, per particle: its parent in the zones' union-find, whether it is
   // in a zone, and (per zone root) whether a held or pinned particle is in it; per triangle, whether
   // the last round moved a corner; whether a zone stays at x0 for the substep (its move as one body
@@ -226,6 +254,11 @@ class SelfContact {
   // each intersects now; the exact triangles made at x0 and at x (slot per triangle, kNone if not
   // made, and the triangles made).
   std::vector<std::uint64_t> tests_;
+  // Per thread, as the pairs are looked at: the tests found, the far pairs measured (by index), and
+  // how many pairs were tested.
+  std::vector<std::vector<std::uint64_t>> scanTests_;
+  std::vector<std::vector<std::pair<std::uint32_t, Contact>>> scanContacts_;
+  std::vector<std::int64_t> scanTested_;
   std::vector<std::uint8_t> hits_;
   std::vector<std::uint32_t> slot0_, slotX_, which0_, whichX_;
   std::vector<std::optional<exact::Triangle>> made0_, madeX_;
