@@ -410,33 +410,37 @@ void SelfContact::boxPrimitive(std::size_t k) {
   boxUpper_[k] = above(upper_[k]);
 }
 
-// Whether the two primitives' boxes lie apart along `axis` (the line between their centres): the
-// hull of the first `split` corners' boxes and that of the rest. Boxes that overlap
-// may still: a vertex's box inside a tilted triangle's box, a layer above it. Then, as for boxes
-// that do not overlap, while every particle keeps half a `distance` inside its box the two stay
-// at least `distance` apart (each hull shrinks by half a distance along the axis); so the pair is
-// not listed. Only where they are apart beyond rounding: the margin grows with the coordinates.
-bool SelfContact::apartBoxes(const std::uint32_t* corners, int split, Vec3 axis) const {
-  const Real length = glm::length(axis);
-  if (!(length > 0.0)) return false;
-  axis /= length;
-  const Vec3 size = glm::abs(axis);
-  Real lo[2] = {std::numeric_limits<Real>::max(), std::numeric_limits<Real>::max()};
-  Real hi[2] = {std::numeric_limits<Real>::lowest(), std::numeric_limits<Real>::lowest()};
-  Real scale = 0.0;
+// Whether the two primitives' boxes lie apart along the line between their centres: the hull of
+// the first `split` corners' boxes and that of the rest. Boxes that overlap may still: a vertex's
+// box inside a tilted triangle's box, a layer above it. Then, as for boxes that do not overlap,
+// while every particle keeps half a `distance` inside its box the two stay at least `distance`
+// apart (each hull shrinks by half a distance along the line); so the pair is not listed. In single
+// precision, from the boxes as the tree keeps them (rounded outwards, so holding the double ones),
+// and all along the line as it is (between twice the boxes' centres, not of unit length), with
+// room for rounding that grows with the coordinates: only where they are apart beyond it.
+bool SelfContact::apartBoxes(const std::uint32_t* corners, int split) const {
+  glm::vec3 twice[4], size[4];  // each corner's box: twice its centre, and its sides
   for (int k = 0; k < 4; ++k) {
-    const Vec3 centre = (lower_[corners[k]] + upper_[corners[k]]) * 0.5;
-    const Real half = glm::dot(upper_[corners[k]] - lower_[corners[k]], size) * 0.5;
-    const Real at = glm::dot(centre, axis);
+    twice[k] = boxLower_[corners[k]] + boxUpper_[corners[k]];
+    size[k] = boxUpper_[corners[k]] - boxLower_[corners[k]];
+  }
+  const glm::vec3 axis = split == 1 ? twice[0] - (twice[1] + twice[2] + twice[3]) * (1.0f / 3.0f)
+                                    : (twice[0] + twice[1]) * 0.5f - (twice[2] + twice[3]) * 0.5f;
+  const glm::vec3 along = glm::abs(axis);
+  float lo[2] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
+  float hi[2] = {std::numeric_limits<float>::lowest(), std::numeric_limits<float>::lowest()};
+  float scale = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    const float at = glm::dot(twice[k], axis), half = glm::dot(size[k], along);
     const int side = k < split ? 0 : 1;
     lo[side] = std::min(lo[side], at - half);
     hi[side] = std::max(hi[side], at + half);
-    // The dot products' rounding grows with the coordinates themselves, not with the projection.
-    scale = std::max(scale, glm::dot(glm::abs(centre), size) + half);
+    scale = std::max(scale, glm::dot(glm::abs(twice[k]), along) + half);
   }
-  const Real margin = 1e-9 + 1e-12 * scale;
+  // A few single-precision roundings of figures up to `scale` lie far under 1e-5 of it; and 1 nm.
+  const float margin = 1e-5f * scale + 2e-9f * (along.x + along.y + along.z);
   // Not apart unless every figure is finite (min and max pass a NaN by).
-  if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + margin)) return false;
+  if (!std::isfinite(lo[0] + hi[0] + lo[1] + hi[1] + margin) || !(margin > 0.0f)) return false;
   return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
 }
 
@@ -506,10 +510,6 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     }
   }
 
-  const auto apart = [&](const std::uint32_t* corners, int split, Vec3 axis) {
-    return apartBoxes(corners, split, axis);
-  };
-
   // Their primitives, in parallel: blocks of leaf pairs to whichever thread is free (a crumpled
   // pile's leaves find far more than a flat sheet's: in even runs, one thread had most of the work
   // and two threads were no faster than one), each block's pairs in its own lists, joined in the
@@ -545,7 +545,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               const glm::uvec3 c = triangles_[t];
               if (c[0] == v || c[1] == v || c[2] == v) continue;
               const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
-              if (apart(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) continue;
+              if (apartBoxes(corners, 1)) continue;
               vertexTriangle.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
             }
           }
@@ -568,7 +568,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
               const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
               if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
               const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
-              if (apart(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
+              if (apartBoxes(corners, 2)) continue;
               edgeEdge.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
             }
           }
@@ -642,7 +642,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
     const glm::uvec3 c = triangles_[t];
     if (c[0] == v || c[1] == v || c[2] == v) return;
     const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
-    if (apartBoxes(corners, 1, x_[v] - (x_[c[0]] + x_[c[1]] + x_[c[2]]) / 3.0)) return;
+    if (apartBoxes(corners, 1)) return;
     pairs_.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
   };
   // A stray vertex against every triangle; a triangle with a stray corner against every vertex
@@ -675,7 +675,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
         const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
         if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
         const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
-        if (apartBoxes(corners, 2, (x_[a[0]] + x_[a[1]]) - (x_[b[0]] + x_[b[1]]))) continue;
+        if (apartBoxes(corners, 2)) continue;
         pairs_.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
       }
     });

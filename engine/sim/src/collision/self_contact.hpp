@@ -174,10 +174,10 @@ class SelfContact {
   bool keepPairs(const std::vector<std::uint32_t>* candidates, Real distance, Workers& workers);
   void refresh(const std::vector<std::uint32_t>& strays);
   // A triangle's or edge's box from its corners' (k: its index among the boxes), or none where it
-  // is torn; whether it is; whether two primitives' boxes lie apart along `axis` (findPairs).
+  // is torn; whether it is; whether two primitives' boxes lie apart along the line between their centres (findPairs).
   void boxPrimitive(std::size_t k);
   bool torn(const std::uint32_t* corners, int count) const;
-  bool apartBoxes(const std::uint32_t* corners, int split, Vec3 axis) const;
+  bool apartBoxes(const std::uint32_t* corners, int split) const;
 
   std::uint64_t meshVersion_ = 0;
   std::size_t meshParticles_ = 0;
