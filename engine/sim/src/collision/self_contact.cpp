@@ -43,6 +43,8 @@ constexpr Real kTorn = 10.0;
 constexpr std::size_t kStraysForSearch = 8;
 // Triangles a leaf of the broad phase's tree holds at most.
 constexpr std::size_t kLeafTriangles = 2;
+// Pairs of nodes the walk of the broad phase's tree is cut into, at least, for the threads to share.
+constexpr std::size_t kWalkTasks = 64;
 // Pairs of leaves a thread takes at a time when it lists their primitives' pairs.
 constexpr std::size_t kLeafPairBlock = 256;
 
@@ -170,7 +172,8 @@ std::size_t SelfContact::bytes() const {
                       b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) +
                       b(which0_) + b(whichX_) + b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
-           b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(stack_) + b(boxTests_);
+           b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(walkTests_) + b(boxTests_);
+  for (const std::vector<std::uint64_t>& walked : walked_) total += b(walked);
   for (const std::vector<Pair>& found : found_) total += b(found);
   for (const std::vector<std::uint64_t>& found : scanTests_) total += b(found);
   for (const auto& measured : scanContacts_) total += b(measured);
@@ -454,19 +457,28 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   const Real grow = distance;
   lower_.resize(n + nt + ne);
   upper_.resize(n + nt + ne);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 to = x0_[i] + (x_[i] - x0_[i]) * ahead;
-    lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
-    upper_[i] = glm::max(glm::max(x0_[i], x_[i]), to) + grow;
-  }
   grow_ = grow;
   boxLower_.resize(n + nt + ne);
   boxUpper_.resize(n + nt + ne);
-  for (std::size_t i = 0; i < n; ++i) {
-    boxLower_[i] = below(lower_[i]);
-    boxUpper_[i] = above(upper_[i]);
-  }
-  for (std::size_t k = n; k < n + nt + ne; ++k) boxPrimitive(k);
+  // Each box on its own: the particles', then the triangles' and edges' from theirs.
+  workers.run(
+      n,
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const Vec3 to = x0_[i] + (x_[i] - x0_[i]) * ahead;
+          lower_[i] = glm::min(glm::min(x0_[i], x_[i]), to) - grow;
+          upper_[i] = glm::max(glm::max(x0_[i], x_[i]), to) + grow;
+          boxLower_[i] = below(lower_[i]);
+          boxUpper_[i] = above(upper_[i]);
+        }
+      },
+      1024);
+  workers.run(
+      nt + ne,
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t k = begin; k < end; ++k) boxPrimitive(n + k);
+      },
+      1024);
   fitTree();
   ++stats_.searches;
 
@@ -477,38 +489,99 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
     const glm::vec3 size = node.upper - node.lower;
     return size.x + size.y + size.z;
   };
-  std::int64_t tests = 0;
-  leafPairs_.clear();
-  stack_.clear();
-  if (!nodes_.empty()) stack_.push_back(both(0, 0));
-  while (!stack_.empty()) {
-    const auto a = static_cast<std::uint32_t>(stack_.back() >> 32), b = static_cast<std::uint32_t>(stack_.back());
-    stack_.pop_back();
+  // One step of the walk from a pair of nodes: the pair of leaves it is, or the pairs of nodes to
+  // look at next (in the order the walk takes them), or nothing where their boxes lie apart.
+  const auto step = [&](std::uint64_t pair, auto&& leaves, auto&& next, std::int64_t& tests) {
+    const auto a = static_cast<std::uint32_t>(pair >> 32), b = static_cast<std::uint32_t>(pair);
     const Node& p = nodes_[a];
     const Node& q = nodes_[b];
     if (a == b) {
       if (isLeaf(p)) {
-        leafPairs_.push_back(both(p.left, p.left));
+        leaves(both(p.left, p.left));
       } else {
-        // Last in, first out: the left half, the right half, then the two against each other.
-        stack_.push_back(both(p.left, p.right));
-        stack_.push_back(both(p.right, p.right));
-        stack_.push_back(both(p.left, p.left));
+        // The left half, the right half, then the two against each other.
+        next(both(p.left, p.left));
+        next(both(p.right, p.right));
+        next(both(p.left, p.right));
       }
-      continue;
+      return;
     }
     ++tests;
-    if (!overlap(p.lower, p.upper, q.lower, q.upper)) continue;
+    if (!overlap(p.lower, p.upper, q.lower, q.upper)) return;
     if (isLeaf(p) && isLeaf(q)) {
-      leafPairs_.push_back(both(std::min(p.left, q.left), std::max(p.left, q.left)));
+      leaves(both(std::min(p.left, q.left), std::max(p.left, q.left)));
     } else if (!isLeaf(p) && (isLeaf(q) || extent(p) >= extent(q))) {
-      stack_.push_back(both(p.right, b));
-      stack_.push_back(both(p.left, b));
+      next(both(p.left, b));
+      next(both(p.right, b));
     } else {
-      stack_.push_back(both(a, q.right));
-      stack_.push_back(both(a, q.left));
+      next(both(a, q.left));
+      next(both(a, q.right));
     }
+  };
+  // The walk's first levels, in its order, until there are enough pairs of nodes to share among
+  // the threads (and the leaves met on the way, in their places); then each of those walked on its
+  // own (depth first, as one walk would), and their leaves joined in that order: the same list,
+  // whatever the number of threads.
+  struct Task {
+    std::uint64_t pair;
+    bool leaf;  // a pair of leaves already
+  };
+  std::vector<Task> tasks, wider;
+  std::int64_t tests = 0;
+  if (!nodes_.empty()) tasks.push_back({both(0, 0), false});
+  for (bool grew = true; grew && tasks.size() < kWalkTasks;) {
+    grew = false;
+    wider.clear();
+    for (const Task& task : tasks) {
+      if (task.leaf) {
+        wider.push_back(task);
+        continue;
+      }
+      grew = true;
+      step(
+          task.pair,
+          [&](std::uint64_t leaf) {
+            wider.push_back({leaf, true});
+          },
+          [&](std::uint64_t pair) {
+            wider.push_back({pair, false});
+          },
+          tests);
+    }
+    tasks.swap(wider);
   }
+  walked_.resize(tasks.size());
+  walkTests_.assign(static_cast<std::size_t>(workers.threads()), 0);
+  workers.runShared(
+      tasks.size(), 1,
+      [&](std::size_t begin, std::size_t end, int thread) {
+        std::int64_t compared = 0;
+        std::uint64_t children[3];
+        for (std::size_t t = begin; t < end; ++t) {
+          std::vector<std::uint64_t>& out = walked_[t];
+          out.clear();
+          if (tasks[t].leaf) {
+            out.push_back(tasks[t].pair);
+            continue;
+          }
+          std::vector<std::uint64_t> stack{tasks[t].pair};
+          while (!stack.empty()) {
+            const std::uint64_t pair = stack.back();
+            stack.pop_back();
+            int count = 0;
+            step(
+                pair, [&](std::uint64_t leaf) { out.push_back(leaf); },
+                [&](std::uint64_t next) { children[count++] = next; }, compared);
+            // Last in, first out: the first to look at goes on top.
+            while (count > 0) stack.push_back(children[--count]);
+          }
+        }
+        walkTests_[static_cast<std::size_t>(thread)] += compared;
+      },
+      1);
+  leafPairs_.clear();
+  for (const std::vector<std::uint64_t>& out : walked_) leafPairs_.insert(leafPairs_.end(), out.begin(), out.end());
+  for (const std::int64_t compared : walkTests_) tests += compared;
 
   // Their primitives, in parallel: blocks of leaf pairs to whichever thread is free (a crumpled
   // pile's leaves find far more than a flat sheet's: in even runs, one thread had most of the work
