@@ -163,6 +163,8 @@ bool overlap(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& otherLo,
 
 }  // namespace
 
+static_assert(sizeof(SelfContact::Pair) <= 20, "a listed pair is 20 bytes: there can be a hundred a particle");
+
 std::size_t SelfContact::bytes() const {
   const auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   std::size_t total = b(clothOf_) + b(rest_) + b(clothSize_) + b(triangles_) + b(edges_) + b(edgeTriangles_) +

@@ -84,7 +84,7 @@ class SelfContact {
   const SelfContactStats& stats() const { return stats_; }
   std::size_t bytes() const;
 
-  // What the broad phase lists: 16 bytes, as many as a hundred a particle in a crumpled pile.
+  // What the broad phase lists: 20 bytes, as many as a hundred a particle in a crumpled pile.
   struct Pair {
     std::uint32_t first, second;  // vertex and triangle, or the two edges (the lower first)
     // Its contact (an index into contacts_), or kFar: apart by more than the distance as the solve
