@@ -151,7 +151,9 @@ Real largest(const Vec3& x) {
 
 // The float at or below v (a proof's separation kept in single precision must not grow).
 float floatBelow(Real v) {
-  if (std::isnan(v)) return kUnproven;
+  constexpr Real most = std::numeric_limits<float>::max();
+  if (std::isnan(v) || v < -most) return kUnproven;
+  if (v > most) return std::numeric_limits<float>::max();  // (converting it would be undefined)
   const auto f = static_cast<float>(v);
   return static_cast<Real>(f) > v ? std::nextafter(f, -INFINITY) : f;
 }
@@ -1168,8 +1170,12 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     // The pairs, in parallel: each run's tests and the far pairs it measured in its own lists,
     // joined in the runs' order (the same whatever the number of threads).
     const auto threads = static_cast<std::size_t>(workers.threads());
+    // (Every thread's lists emptied here: a loop over fewer pairs than a thread's share runs on
+    // fewer threads, and the others' lists would still hold an earlier round's.)
     scanTests_.resize(threads);
     scanContacts_.resize(threads);
+    for (std::vector<std::uint64_t>& found : scanTests_) found.clear();
+    for (auto& measured : scanContacts_) measured.clear();
     scanTested_.assign(threads, 0);
     workers.run(
         pairs_.size(),
