@@ -1183,10 +1183,8 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
           const auto t = static_cast<std::size_t>(thread);
           std::vector<std::uint64_t> found;  // (on the thread's stack while it is filled, as in findPairs)
           std::vector<std::pair<std::uint32_t, Contact>> measured;
-          found.swap(scanTests_[t]);
+          found.swap(scanTests_[t]);  // (emptied before the loop)
           measured.swap(scanContacts_[t]);
-          found.clear();
-          measured.clear();
           std::int64_t tested = 0;
           for (std::size_t i = begin; i < end; ++i) {
             Pair& p = pairs_[i];
