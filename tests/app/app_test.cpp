@@ -298,9 +298,12 @@ double largestDifference(const json& a, const json& b) {
 // The app replays a gesture through SDL's touch events; drape-cli replays it straight into the
 // engine. They must end in the same state: a world point travels beside its touch event (it used
 // to be projected onto the screen and back onto the table, so the fold gesture ended 0.57 m off),
-// and a down's own radius with it (the tear ended with 737 particles, not 733). Screen points go
-// through SDL's single-precision touch coordinates, so the tolerance is 1e-6 m (the world-point
-// gestures were seen to end bit for bit the same; docs/app.md). The gestures that cover every path an event takes
+// and a down's own radius with it (the tear ended with 737 particles, not 733). The world-point
+// gestures end bit for bit the same (held to 1e-6 m). Screen points go through SDL's single-precision
+// touch coordinates: translate-screen's finger lands about 1e-8 m from drape-cli's, and the cloth,
+// sliding on the table with stick and slip, carries that to 5.5e-5 m in 2.5 s (drape-cli's own
+// result moves 4.6e-5 m when its screen points move by 3e-7 of themselves). So that one is held to
+// 1 mm, a twenty-fifth of the desk's spacing: a wrong path from screen to table ends centimetres off. The gestures that cover every path an event takes
 // (world and screen points, a down's radius, pin, lift and unpin, pinch-lift, cut, draw, tearing): the
 // self-contact-heavy rest (crumple, drape, rotate, spread, translate) take the app 7 to 20 s each
 // and the same paths; docs/app.md says how they were checked. Labelled `long` (tests/CMakeLists.txt):
@@ -328,7 +331,7 @@ TEST_F(App, ReplayingAShippedGestureEndsWhereDrapeCliReplayEnds) {
   for (const std::string& gesture : gestures) {
     const json app = state(file("app-" + gesture + ".json")), cli = state(file("cli-" + gesture + ".json"));
     EXPECT_EQ(app["steps"], cli["steps"]) << gesture;
-    EXPECT_LE(largestDifference(app, cli), 1e-6) << gesture;
+    EXPECT_LE(largestDifference(app, cli), gesture == "translate-screen" ? 1e-3 : 1e-6) << gesture;
   }
 }
 

@@ -440,7 +440,7 @@ MemoryUse World::memoryUse() const {
   for (const SolverScratch& s : scratch_) {
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
-                bytes(s.contactDepth) + bytes(s.lambda) + bytes(s.bendingLambda) + bytes(s.looseStretch) +
+                bytes(s.contactDepth) + bytes(s.contactRub) + bytes(s.lambda) + bytes(s.bendingLambda) + bytes(s.looseStretch) +
                 bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) +
                 bytes(s.batchStart) + bytes(s.bendingFactor.stencils) + bytes(s.bendingFactor.inverseMass) +
                 bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work) + bytes(s.bendingFactor.rank);
@@ -572,7 +572,7 @@ void World::runStage(Stage stage, PartClock& parts) {
       case Stage::projectConstraints:
         // Planned when the world changed (planAll); should a path have missed it, the plan shows here.
         if (scratch.planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
-        position::projectConstraints(cloth, settings_.solver, h, scratch, !colliders_.empty(), *workers_, parts);
+        position::projectConstraints(cloth, settings_.solver, h, scratch, colliders_, *workers_, parts);
         break;
       case Stage::dampConstraints: position::dampConstraints(cloth); break;
       case Stage::clampTravel:

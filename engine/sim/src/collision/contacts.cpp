@@ -73,6 +73,7 @@ void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch&
     scratch.contactNormal.assign(n, Vec3{0.0});
     scratch.contactOffset.assign(n, 0.0);
     scratch.contactDepth.assign(n, 0.0);
+    scratch.contactRub.assign(n, Vec3{0.0});
   }
   const Real thickness = cloth.settings.thickness;
   for (std::size_t i = 0; i < n; ++i) {
@@ -91,6 +92,7 @@ void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch&
       scratch.contactOffset[i] = candidate.offset;
     }
     scratch.contactDepth[i] = 0.0;
+    scratch.contactRub[i] = Vec3{0.0};
   }
   project(cloth, scratch);
 }
@@ -109,7 +111,7 @@ void project(Cloth& cloth, SolverScratch& scratch) {
   }
 }
 
-void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, const SolverScratch& scratch) {
+void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   for (std::size_t i = 0; i < scratch.contactCollider.size(); ++i) {
     const int c = scratch.contactCollider[i];
@@ -121,12 +123,18 @@ void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, cons
     const Vec3 relative = (s.position[i] - s.previousPosition[i]) -
                           colliders[static_cast<std::size_t>(c)].surfaceVelocity(s.position[i]) * h;
     const Vec3 tangential = relative - n * glm::dot(n, relative);
-    const Real length = glm::length(tangential);
+    // The friction so far is part of that motion: without it the particle would have moved `free`.
+    Vec3& rub = scratch.contactRub[i];
+    const Vec3 free = tangential - rub;
+    const Real length = glm::length(free);
+    Vec3 next{0.0};  // the friction's whole correction this substep, after this call
     if (length < f.staticCoefficient * depth) {
-      s.position[i] -= tangential;
+      next = -free;  // stuck: back where the substep began, relative to the surface
     } else if (length > 0.0) {
-      s.position[i] -= tangential * std::min(f.kineticCoefficient * depth / length, 1.0);
+      next = free * -std::min(f.kineticCoefficient * depth / length, Real{1.0});
     }
+    s.position[i] += next - rub;
+    rub = next;
   }
 }
 

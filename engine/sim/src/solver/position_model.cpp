@@ -434,8 +434,8 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, Real h, SolverSc
 
 }  // namespace
 
-void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, bool contacts,
-                        Workers& workers, PartClock& parts) {
+void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch,
+                        const std::vector<Collider>& colliders, Workers& workers, PartClock& parts) {
   if (solver.xpbd || cloth.settings.fabric) {
     for (ConstraintKind kind : kConstraintKinds) {
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
@@ -455,7 +455,12 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
     } else {
       sweepInOrder(cloth, solver, h, scratch, parts);
     }
-    if (contacts) parts.time(Stage::contactPlanes, [&] { contact::project(cloth, scratch); });
+    if (!colliders.empty()) {
+      parts.time(Stage::contactPlanes, [&] {
+        contact::project(cloth, scratch);
+        contact::friction(cloth, colliders, h, scratch);
+      });
+    }
   }
 }
 

@@ -42,6 +42,7 @@ struct SolverScratch {
   std::vector<Vec3> contactNormal;
   std::vector<Real> contactOffset;  // m
   std::vector<Real> contactDepth;   // m, penetration resolved this substep (for friction)
+  std::vector<Vec3> contactRub;     // m, the friction's tangential correction so far this substep
   // XPBD: the Lagrange multiplier of every constraint, by kind, reset each substep.
   std::array<std::vector<Real>, kConstraintKindCount> lambda;
   std::vector<Vec3> bendingLambda;  // a fabric's bend stencils (XPBD, a vector multiplier each), reset each substep
