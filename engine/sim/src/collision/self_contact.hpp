@@ -19,7 +19,8 @@
 //    was proven of a pair (how far apart, along a line) it keeps from one substep to the next, less
 //    how far its corners have gone since: a pair still proven far is not looked at again. Then
 //    Coulomb friction in position form on each pair that was pushed: the tangential part of its
-//    relative motion, removed up to `friction` times the push.
+//    relative motion, removed up to `friction` times the push, a push of at most `distance` (a
+//    bigger one is a link pulled through the other layer being taken back, not layers pressed).
 // 3. Fail-safe. Along the straight path from x0 to x, two primitives at x0-distance g can only
 //    meet if their corners' relative motion m (the largest |dx_i - dx_j| between a corner of one
 //    and of the other) reaches g. A pair with m < g is proven apart, as is one whose corners' hulls

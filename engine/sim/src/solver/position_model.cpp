@@ -2,9 +2,9 @@
 
 #include "drape/sim/metrics.hpp"
 
+#include "collision/contacts.hpp"
 #include "solver/aerodynamics.hpp"
 #include "solver/bending.hpp"
-#include "collision/contacts.hpp"
 #include "solver/distance_wide.hpp"
 #include "solver/lines.hpp"
 
