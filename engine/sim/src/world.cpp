@@ -15,16 +15,16 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
-#include "solver/batches.hpp"
 #include "collision/contacts.hpp"
+#include "collision/self_contact.hpp"
+#include "parallel/workers.hpp"
+#include "solver/batches.hpp"
 #include "solver/force_model.hpp"
 #include "solver/lines.hpp"
 #include "solver/position_model.hpp"
-#include "collision/self_contact.hpp"
 #include "solver/solver_scratch.hpp"
 #include "solver/tethers.hpp"
 #include "topology/topology.hpp"
-#include "parallel/workers.hpp"
 
 namespace drape::sim {
 
@@ -440,10 +440,11 @@ MemoryUse World::memoryUse() const {
   for (const SolverScratch& s : scratch_) {
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
-                bytes(s.contactDepth) + bytes(s.contactRub) + bytes(s.lambda) + bytes(s.bendingLambda) + bytes(s.looseStretch) +
-                bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) + bytes(s.lineStiff) +
-                bytes(s.batchStart) + bytes(s.bendingFactor.stencils) + bytes(s.bendingFactor.inverseMass) +
-                bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work) + bytes(s.bendingFactor.rank);
+                bytes(s.contactDepth) + bytes(s.contactRub) + bytes(s.lambda) + bytes(s.bendingLambda) +
+                bytes(s.looseStretch) + bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) +
+                bytes(s.lineStiff) + bytes(s.batchStart) + bytes(s.bendingFactor.stencils) +
+                bytes(s.bendingFactor.inverseMass) + bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work) +
+                bytes(s.bendingFactor.rank);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
       m.lines +=

@@ -13,8 +13,8 @@
 #include "drape/sim/settings.hpp"
 #include "drape/sim/state.hpp"
 #include "drape/sim/world.hpp"
-#include "solver/solver_scratch.hpp"
 #include "parallel/workers.hpp"
+#include "solver/solver_scratch.hpp"
 
 namespace drape::sim::contact {
 

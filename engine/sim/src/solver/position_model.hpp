@@ -9,9 +9,9 @@
 
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
+#include "parallel/workers.hpp"
 #include "part_clock.hpp"
 #include "solver/solver_scratch.hpp"
-#include "parallel/workers.hpp"
 
 namespace drape::sim::position {
 
@@ -44,11 +44,11 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
 // Each sweep starts with the tethers (scratch.tethers), if any (and projects them again after each
 // of the lines' Newton steps with solver.tethersBetweenSteps). With `colliders`, the contact
 // planes are re-enforced after every sweep, so the constraints cannot pull a particle back into a
-// collider, and friction acts there too (contact::friction), so the next sweep sees a stuck particle stay. With solver.xpbd each kind resists with its compliance instead (see settings.hpp); with
-// solver.lines the stretch constraints are solved a line at a time (lines.hpp; scratch.lines
-// built). Batches, lines and tethers are shared among the workers: the result does not depend on
-// how many there are. Each part (tethers, each kind, the loose links, the contact planes) is timed
-// by `parts`.
+// collider, and friction acts there too (contact::friction), so the next sweep sees a stuck particle stay. With
+// solver.xpbd each kind resists with its compliance instead (see settings.hpp); with solver.lines the stretch
+// constraints are solved a line at a time (lines.hpp; scratch.lines built). Batches, lines and tethers are shared among
+// the workers: the result does not depend on how many there are. Each part (tethers, each kind, the loose links, the
+// contact planes) is timed by `parts`.
 void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch,
                         const std::vector<Collider>& colliders, Workers& workers, PartClock& parts);
 
