@@ -323,11 +323,14 @@ void World::buildPipeline() {
     // (after them, a push in a dense pile could stretch an edge by up to the collision distance).
     if (selfCollision) add(Stage::selfCollide, true);
     if (anyColliders) add(Stage::collide, true);
-    if (anyProjected && settings_.solver.iterations > 0) add(Stage::projectConstraints, true);
+    const bool sweeps = anyProjected && settings_.solver.iterations > 0;
+    if (sweeps) add(Stage::projectConstraints, true);
     // Self-contact after everything else that moves positions, so that its fail-safe has the last
     // word: nothing after it in a substep moves a particle (constraint damping changes velocities).
-    // It applies the colliders' friction itself, between its sweeps and its fail-safe.
-    if (anyColliders && !selfContact) add(Stage::friction, true);
+    // It applies the colliders' friction itself, between its sweeps and its fail-safe. Without it,
+    // the sweeps apply it after each one (timed as their part `contact planes`), and the stage is
+    // wanted only where there are no sweeps.
+    if (anyColliders && !selfContact && !sweeps) add(Stage::friction, true);
     if (selfContact) add(Stage::selfContact, true);
     if (selfCollision) add(Stage::clampTravel, true);
     if (anyDamped) add(Stage::dampConstraints, true);

@@ -441,7 +441,15 @@ TEST(Pipeline, NothingToCollideWithMeansNoCollisionStages) {
   settings.colliders.push_back(plane({0, 0, 0}, {0, 1, 0}, 0.5));
   World colliding(settings);
   EXPECT_TRUE(colliding.hasStage(Stage::collide));
-  EXPECT_TRUE(colliding.hasStage(Stage::friction));
+  // Friction acts after every sweep, inside the constraint stage: no stage of its own to do it again.
+  EXPECT_TRUE(colliding.hasStage(Stage::projectConstraints));
+  EXPECT_FALSE(colliding.hasStage(Stage::friction));
+  // With no sweeps, it has its own.
+  settings.solver.iterations = 0;
+  World unswept(settings);
+  EXPECT_TRUE(unswept.hasStage(Stage::collide));
+  EXPECT_FALSE(unswept.hasStage(Stage::projectConstraints));
+  EXPECT_TRUE(unswept.hasStage(Stage::friction));
 }
 
 TEST(ForceModel, SpringClothRestsOnTheTableToo) {
