@@ -24,7 +24,7 @@ enum class Stage : std::uint8_t {
   dampConstraints,     // remove a fraction of relative velocity along each damped constraint
   clampTravel,         // self-collision: cap the velocity carried into the next substep
   collide,             // find contact planes along each particle's motion; project onto them
-  friction,            // Coulomb friction against colliders, after the sweeps
+  friction,            // Coulomb friction against colliders where no sweeps apply it (they do after each)
   selfCollide,         // push apart particles of a cloth that come too close
   selfContact,         // keep triangles apart and never through each other (self_contact.hpp)
   // force model, once per substep: forces are evaluated inside the integrator
