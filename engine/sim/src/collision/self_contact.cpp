@@ -87,8 +87,9 @@ constexpr float kUnproven = -std::numeric_limits<float>::infinity();
 // than its cloth at rest too, it takes none: findPairs).
 constexpr Real kTorn = 10.0;
 
-// Where more than one particle in this many leaves its box in the fail-safe, the pairs are found
-// again by a search; fewer, by pairing again what their primitives' boxes overlap (a refresh).
+// Where more than one particle in this many leaves its box (as a substep begins, or in the
+// fail-safe), the pairs are found again by a search; fewer, by pairing again what their primitives'
+// boxes overlap (a refresh).
 constexpr std::size_t kStraysForSearch = 8;
 // Triangles a leaf of the broad phase's tree holds at most.
 constexpr std::size_t kLeafTriangles = 2;
@@ -849,14 +850,10 @@ Real SelfContact::proven(const Pair& p) const {
   return static_cast<Real>(p.apart) - most[0] - most[1];
 }
 
-Real SelfContact::separation(const Pair& p) const {
-  // Along the line between the two primitives' centres at x0: the hull of one's corners at x0 and
-  // at x against the other's. Apart there, they are apart all along the straight paths from x0 to
-  // x (each corner's path lies between its two ends).
-  const std::array<std::uint32_t, 4> v = corners(p);
-  const Vec3 axis = p.edges ? (x0_[v[0]] + x0_[v[1]]) * 0.5 - (x0_[v[2]] + x0_[v[3]]) * 0.5
-                            : x0_[v[0]] - (x0_[v[1]] + x0_[v[2]] + x0_[v[3]]) * (1.0 / 3.0);
-  const int split = p.edges ? 2 : 1;
+Real SelfContact::separationAlong(const std::array<std::uint32_t, 4>& v, int split, const Vec3& axis) const {
+  // The hull of one side's corners at x0 and at x against the other's, along the axis. Apart there,
+  // they are apart all along the straight paths from x0 to x (each corner's path lies between its
+  // two ends).
   Real lo[2], hi[2];
   for (int side = 0; side < 2; ++side) {
     lo[side] = std::numeric_limits<Real>::max();
@@ -879,6 +876,14 @@ Real SelfContact::separation(const Pair& p) const {
   if (!(length > 0.0) || !std::isfinite(apart + lo[0] + hi[0] + lo[1] + hi[1]))
     return -std::numeric_limits<Real>::infinity();
   return apart;
+}
+
+Real SelfContact::separation(const Pair& p) const {
+  // Along the line between the two primitives' centres at x0: cheap, and enough for most.
+  const std::array<std::uint32_t, 4> v = corners(p);
+  const Vec3 centres = p.edges ? (x0_[v[0]] + x0_[v[1]]) * 0.5 - (x0_[v[2]] + x0_[v[3]]) * 0.5
+                               : x0_[v[0]] - (x0_[v[1]] + x0_[v[2]] + x0_[v[3]]) * (1.0 / 3.0);
+  return separationAlong(v, p.edges ? 2 : 1, centres);
 }
 
 SelfContact::Contact SelfContact::measure(Pair& pair, Real distance) const {
@@ -934,8 +939,12 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
         1024);
   }
   // Two loops cut alike (as many pairs, in as many runs): the first tells each run's far pairs from
-  // its near ones and counts these; the second measures them into contacts_, each run's from where
-  // the runs before it end, in the pairs' order whatever the number of threads.
+  // the others (by what is carried, or along the line between the centres) and counts these; the
+  // second measures them into contacts_, each run's from where the runs before it end, in the
+  // pairs' order whatever the number of threads. A measured pair the line between its closest points
+  // proves far is far after all (what lies side by side, as a lattice's parallel diagonals, is not
+  // apart along the centres' line): its slot in contacts_ stays empty (gap0 -1, which no sweep
+  // looks at).
   const auto threads = static_cast<std::size_t>(workers.threads());
   std::vector<std::size_t>& near = runNear_;
   near.assign(threads + 1, 0);
@@ -964,8 +973,17 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
         for (std::size_t i = begin; i < end; ++i) {
           Pair& pair = pairs_[i];
           if (pair.contact == kFar) continue;
-          pair.contact = next;
-          contacts_[next++] = measure(pair, distance);
+          Contact& contact = contacts_[next];
+          contact = measure(pair, distance);
+          const Real apart = separationAlong(corners(pair), pair.edges ? 2 : 1, contact.normal);
+          if (apart > distance) {
+            pair.apart = floatBelow(apart);
+            pair.contact = kFar;
+            contact.gap0 = -1.0;
+          } else {
+            pair.contact = next;
+          }
+          ++next;
         }
       },
       1024);
@@ -1282,6 +1300,9 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
             } else {
               gap0 = contacts_[p.contact].gap0;
             }
+            // Along the line between the closest points at x0 (the contact's normal).
+            const Contact& contact = far ? measured.back().second : contacts_[p.contact];
+            if (separationAlong(corners(p), p.edges ? 2 : 1, contact.normal) > kProofMargin) continue;
             // The largest relative motion of a corner of one against a corner of the other.
             Real m = 0.0;
             const int split = p.edges ? 2 : 1;
@@ -1517,20 +1538,26 @@ void SelfContact::findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<Solv
                                     int substepsLeft, Workers& workers) {
   const bool fresh = prepare(cloths, topologyVersion);
   gather(cloths, &scratch, nullptr);
-  // The pairs found at a substep serve the rest of its step while every particle, at x0 and now,
-  // keeps half a `distance` inside its box: two primitives within `distance` of each other are then
-  // still among them. (A refresh here, of the particles that did not, would find fewer pairs again,
-  // but the boxes of the others, left from earlier, larger motion, then pair them with more: in the
-  // crumple at 64 x 64 twice the memory for a third less time.)
-  if (fresh || distance_ != settings.distance || !strays(nullptr, 0.5 * settings.distance).empty()) {
-    // Looking ahead pays while the motion is smooth enough for the pairs to serve again; where they
-    // did not, the next boxes hold this substep's motion only.
-    findPairs(settings.distance, reused_ ? static_cast<Real>(std::max(substepsLeft, 1)) : 1.0, workers);
-    distance_ = settings.distance;
-    reused_ = false;
-  } else {
-    reused_ = true;
+  // The pairs found at a substep serve on while every particle, at x0 and now, keeps half a
+  // `distance` inside its box: two primitives within `distance` of each other are then still among
+  // them. Where few particles did not (fewer than one in kStraysForSearch), only theirs are paired
+  // again (a refresh, as the fail-safe does), else all are found anew. (The others' boxes, left from
+  // earlier and larger motion, then pair them with more than a search would: in the crumple at
+  // 64 x 64 the pairs grew by up to 1.7 times, and the frame took a fifth less time, the desk tear
+  // 45 % less, the drape over the sphere 12 % less.)
+  if (!fresh && distance_ == settings.distance) {
+    const bool few = strays(nullptr, 0.5 * settings.distance).size() * kStraysForSearch <= x_.size();
+    if (!strays_.empty() && few) refresh(strays_);
+    if (few) {
+      reused_ = true;
+      return;
+    }
   }
+  // Looking ahead pays while the motion is smooth enough for the pairs to serve again; where they
+  // did not, the next boxes hold this substep's motion only.
+  findPairs(settings.distance, reused_ ? static_cast<Real>(std::max(substepsLeft, 1)) : 1.0, workers);
+  distance_ = settings.distance;
+  reused_ = false;
 }
 
 void SelfContact::finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers,

@@ -14,10 +14,11 @@
 //    is linear in the positions, C(x) = sum_k c_k (n . x_k) - target >= 0 with sum_k c_k = 0, and
 //    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding), except
 //    where that would move a particle far more than the points part (kLeverage). A pair whose
-//    corners lie more than `distance` apart along the line between its centres all through the
-//    substep is far: not measured, not pushed (the fail-safe proves it apart by that line). What
-//    was proven of a pair (how far apart, along a line) it keeps from one substep to the next, less
-//    how far its corners have gone since: a pair still proven far is not looked at again. Then
+//    corners lie more than `distance` apart along the line between its centres, or else along the
+//    line between its closest points at x0, all through the substep is far: not pushed (the
+//    fail-safe proves it apart by those lines). What was proven of a pair (how far apart, along a
+//    line) it keeps from one substep to the next, less how far its corners have gone since: a pair
+//    still proven far is not looked at again. Then
 //    Coulomb friction in position form on each pair that was pushed: the tangential part of its
 //    relative motion, removed up to `friction` times the push, a push of at most `distance` (a
 //    bigger one is a link pulled through the other layer being taken back, not layers pressed).
@@ -40,7 +41,8 @@
 //    ends; where nothing is left to join or stop, the whole substep goes back to x0. Where the
 //    contacts or a zone's move take particles out of their boxes, the pairs are found again first:
 //    where fewer than one in eight left, those of the triangles and edges they are corners of only,
-//    each by its box (a refresh: what a search would find), else by a search.
+//    each by its box (a refresh: what a search would find), else by a search. A substep begins the
+//    same way, where particles came within half a `distance` of their boxes' sides.
 //
 // A uniform motion is no contact at all (the relative motion is zero), so a falling cloth falls as
 // it would without self-contact. Deterministic whatever the number of threads: the tree's walk lists
@@ -151,6 +153,9 @@ class SelfContact {
   // for rounding; -inf where they overlap there or a figure is not finite.
   Real separation(const Pair& pair) const;
   bool apartAlongCentres(const Pair& pair, Real margin) const { return separation(pair) > margin; }
+  // The same along a given line (not of unit length): the line between the closest points at x0
+  // (a contact's normal) proves apart what lies side by side, where the centres' line does not.
+  Real separationAlong(const std::array<std::uint32_t, 4>& corners, int split, const Vec3& axis) const;
   // How far apart the pair is proven to be still, from what was proven when the pairs were last
   // measured and how far its corners went since (reach_).
   Real proven(const Pair& pair) const;
