@@ -780,7 +780,7 @@ TEST(Tearing, AFastPullTearsAWideSheetInTwoBetweenItsGrips) {
   // middle of its near edge: from its first break the sheet is in two, the pinned side apart from
   // the pulled, within 0.4 s, several breaks a step (one a step would take 128 steps, 2.1 s). Not
   // the 0.2 s, nor along the notch: the crack from the notch runs a third of the way across
-  // and turns, and the sheet parts near the pulled side at 0.30 s (docs/design.md). Two pieces
+  // and turns, and the sheet parts near the pulled side at 0.33 s (docs/design.md). Two pieces
   // alone is not enough: a shred torn off at a corner of the grip makes two by 0.1 s.
   const int n = 128;
   const Real h = 1.0 / (n - 1);

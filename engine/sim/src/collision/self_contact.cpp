@@ -1541,10 +1541,10 @@ void SelfContact::findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<Solv
   // The pairs found at a substep serve on while every particle, at x0 and now, keeps half a
   // `distance` inside its box: two primitives within `distance` of each other are then still among
   // them. Where few particles did not (fewer than one in kStraysForSearch), only theirs are paired
-  // again (a refresh, as the fail-safe does), else all are found anew. (The others' boxes, left from
-  // earlier and larger motion, then pair them with more than a search would: in the crumple at
-  // 64 x 64 the pairs grew by up to 1.7 times, and the frame took a fifth less time, the desk tear
-  // 45 % less, the drape over the sphere 12 % less.)
+  // again (a refresh, as the fail-safe does), else all are found anew. (The others' boxes, left
+  // from earlier and larger motion, then pair them with more than a search would: the crumple at
+  // 64 x 64 holds a fifth more bytes a particle; but its frames take 2 to 10 % less time, the
+  // fold's a fifth less and the tear's a third: docs/self-contact.md.)
   if (!fresh && distance_ == settings.distance) {
     const bool few = strays(nullptr, 0.5 * settings.distance).size() * kStraysForSearch <= x_.size();
     if (!strays_.empty() && few) refresh(strays_);
