@@ -512,25 +512,23 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       ImGui::SameLine();
       changed |= ImGui::Checkbox("tethers", &tuned.solver.tethers);
       tip("long-range limits from every pinned particle: a hanging cloth cannot stretch past its length");
-      ImGui::SameLine();
-      changed |= ImGui::Checkbox("lines", &tuned.solver.lines);
-      tip("the fast sweep: each lattice line's stretch solved exactly at once, not link by link");
       // On a line of its own: the row above is full.
-      if (tuned.solver.lines) {
-        changed |= ImGui::Checkbox("geometric stiffness", &tuned.solver.geometricStiffness);
-        tip("lines: the bending of a line under tension in its solve (steadier under a finger's pull)");
+      int stretchSolver = static_cast<int>(tuned.solver.stretchSolver);
+      if (ImGui::Combo("stretch solver", &stretchSolver, "gauss-seidel\0lines\0")) {
+        tuned.solver.stretchSolver = static_cast<sim::StretchSolver>(stretchSolver);
+        changed = true;
       }
-      // Each on a line of its own: two do not fit side by side.
-      if (tuned.solver.lines && tuned.solver.tethers) {
-        changed |= ImGui::Checkbox("tethers between line steps", &tuned.solver.tethersBetweenSteps);
-        tip("tethers projected again between the line steps, not only after them");
-      }
-      if (tuned.solver.lines) {
-        changed |= ImGui::SliderInt("extra steps", &tuned.solver.extraLineSteps, 0, 8);
-        tip("line steps a sweep may add while a link is stretched more than 'max stretch'");
-        if (tuned.solver.extraLineSteps > 0) {
-          changed |= sliderReal("max stretch", tuned.solver.stretchTolerance, 0.0, 0.2, "%.3f");
+      tip("gauss-seidel: the seed's sweep, link by link; lines: each lattice line's stretch solved exactly at "
+          "once (the fast sweep)");
+      if (tuned.solver.lines() && !tuned.solver.xpbd) {
+        bool target = tuned.solver.maxStretch > 0.0;
+        if (ImGui::Checkbox("work to a max stretch", &target)) {
+          tuned.solver.maxStretch = target ? 0.04 : 0.0;
+          changed = true;
         }
+        tip("the line solve takes what it needs (geometric stiffness on taut lines, tethers between its steps, "
+            "up to 4 more steps) while a link is longer than this");
+        if (target) changed |= sliderReal("max stretch", tuned.solver.maxStretch, 0.001, 0.2, "%.3f");
       }
     }
     int threads = session.threads();
@@ -579,8 +577,8 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     }
   }
   if (changed) {
-    // A key switched off takes the keys that need it with it (unticking lines: geometric stiffness,
-    // tethers between line steps, extra steps): the engine's one rule for it.
+    // A key switched off takes the keys that need it with it (back to gauss-seidel, or XPBD ticked:
+    // the stretch target): the engine's one rule for it.
     tuned.solver = sim::consistent(tuned.solver);
     session.tune(tuned);
   }

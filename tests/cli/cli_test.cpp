@@ -333,11 +333,11 @@ TEST_F(Cli, StudyChoosesTheCheapestRunWithinTheStrainBound) {
   // On the chain one substep of two sweeps stretches it by far more than 5 % on its way
   // down, eight substeps do not.
   const fs::path folder = file("choice"), report = file("choice.md");
-  const Result result =
-      run("study chain --set solver.lines=false --time 1 --repeats 1 --no-reference --choose 0.05 --sweep "
-          "solver.substeps=1,8 --sweep "
-          "solver.iterations=2 --quiet --out-dir '" +
-          folder.string() + "' --report '" + report.string() + "'");
+  const Result result = run(
+      "study chain --set solver.stretchSolver=gauss-seidel --time 1 --repeats 1 --no-reference --choose 0.05 --sweep "
+      "solver.substeps=1,8 --sweep "
+      "solver.iterations=2 --quiet --out-dir '" +
+      folder.string() + "' --report '" + report.string() + "'");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   std::istringstream csv(read(folder / "accuracy.csv"));
   std::string line;
@@ -381,6 +381,25 @@ TEST_F(Cli, BenchQuickKeepsWhatIsGivenExplicitly) {
   EXPECT_EQ(rows, 1);
 }
 
+TEST_F(Cli, BenchTakesHang2sStretchTargetFromTheCommandLine) {
+  // --max-stretch 0: plain line steps, none extra, and the report says so; out of 0..1: refused.
+  const fs::path folder = file("target"), report = file("target.md");
+  const Result result =
+      run("bench --quick --sizes 16 --threads 1 --naive-iterations 0 --scenes '' --touch-sizes 0 --max-stretch 0 "
+          "--quiet --out-dir '" +
+          folder.string() + "' --report '" + report.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NE(read(report).find("with no stretch target (`--max-stretch 0`)"), std::string::npos);
+  std::istringstream csv(read(folder / "performance.csv"));
+  std::string line;
+  std::getline(csv, line);  // header
+  ASSERT_TRUE(std::getline(csv, line));
+  EXPECT_EQ(line.substr(line.rfind(',') + 1), "0") << line;  // no extra line steps
+  const Result refused = run("bench --quick --max-stretch 1.5 --quiet --out-dir '" + folder.string() + "'");
+  EXPECT_NE(refused.exitCode, 0);
+  EXPECT_NE(refused.err.find("--max-stretch"), std::string::npos) << refused.err;
+}
+
 TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
   const fs::path folder = file("performance"), report = file("performance.md");
   const Result result = run("bench --quick --scenes hang2-tear --touch-sizes 0 --quiet --out-dir '" + folder.string() +
@@ -392,7 +411,7 @@ TEST_F(Cli, BenchTimesHang2AgainstTheNaiveBaselineAndWritesItsReport) {
   std::getline(csv, line);
   EXPECT_EQ(line,
             "scene,n,particles,solver,threads,substeps,iterations,ms_per_frame,ms_per_frame_min,projections_per_s,"
-            "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle,tethers_between_steps,"
+            "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle,"
             "extra_line_steps_per_frame");
   int drape = 0, naive = 0, tear = 0;
   double drapeStrain = 1.0, naiveStrain = 0.0;

@@ -154,7 +154,9 @@ inline int affordableSteps(const sim::WorldSettings& world, double particles, in
   const sim::SolverSettings& s = world.solver;
   double sweeps = 4.0;  // the force model: RK4 evaluates the forces four times a substep
   if (s.model == sim::Model::position) {
-    sweeps = std::max(1, s.iterations) * (1.0 + (s.lines ? 2.0 + s.extraLineSteps : 0.0)) + 1.0;
+    sweeps =
+        std::max(1, s.iterations) * (1.0 + (s.lines() ? 2.0 + (s.maxStretch > 0.0 ? sim::kExtraLineSteps : 0) : 0.0)) +
+        1.0;
   }
   if (world.selfCollision.enabled) sweeps += selfContactSweeps(world);
   const double perStep = std::max(1.0, particles) * std::max(1, s.substeps) * sweeps;

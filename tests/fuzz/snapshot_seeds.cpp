@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
       {"torn", "hang2-tear", {six, sixRows, "cloths.0.pins.1.particle=[5,0]", "tearing.threshold=1.01"}, 40},
       {"torn-lines-tethers",
        "hang2-tear",
-       {six, sixRows, "cloths.0.pins.1.particle=[5,0]", "tearing.threshold=1.01", "solver.lines=true",
+       {six, sixRows, "cloths.0.pins.1.particle=[5,0]", "tearing.threshold=1.01", "solver.stretchSolver=\"lines\"",
         "solver.tethers=true"},
        40},
       {"star", "star", {"cloths.0.outline.spacing=0.12"}, 5},

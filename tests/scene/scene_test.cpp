@@ -364,68 +364,60 @@ TEST(SceneReader, XpbdTethersAndComplianceBelongToThePositionModel) {
             "s.json: solver.tethers: expected false for the force model (it belongs to the position model), got true");
 }
 
-TEST(SceneReader, GeometricStiffnessIsPartOfTheLineSolve) {
+TEST(SceneReader, TheStretchSolverIsNamed) {
+  EXPECT_EQ(parseScene(minimal(), "s.json").world.solver.stretchSolver, sim::StretchSolver::gaussSeidel);
   json document = minimal();
-  applyOverride(document, "solver.lines=true");
-  applyOverride(document, "solver.geometricStiffness=true");
-  EXPECT_TRUE(parseScene(document, "s.json").world.solver.geometricStiffness);
-  EXPECT_FALSE(parseScene(minimal(), "s.json").world.solver.geometricStiffness);
-  applyOverride(document, "solver.lines=false");
+  applyOverride(document, "solver.stretchSolver=\"lines\"");
+  EXPECT_EQ(parseScene(document, "s.json").world.solver.stretchSolver, sim::StretchSolver::lines);
+  applyOverride(document, "solver.stretchSolver=\"jacobi\"");
   EXPECT_EQ(errorOf([&] { parseScene(document, "s.json"); }),
-            "s.json: solver.geometricStiffness: expected false unless \"lines\" is true (it is part of the line "
-            "solve), got true");
-}
-
-TEST(SceneReader, TethersBetweenStepsNeedLinesAndTethers) {
-  json document = minimal();
-  applyOverride(document, "solver.lines=true");
-  applyOverride(document, "solver.tethers=true");
-  applyOverride(document, "solver.tethersBetweenSteps=true");
-  EXPECT_TRUE(parseScene(document, "s.json").world.solver.tethersBetweenSteps);
-  EXPECT_FALSE(parseScene(minimal(), "s.json").world.solver.tethersBetweenSteps);
-  for (const char* off : {"solver.lines=false", "solver.tethers=false"}) {
-    json without = document;
-    applyOverride(without, off);
-    EXPECT_EQ(errorOf([&] { parseScene(without, "s.json"); }),
-              "s.json: solver.tethersBetweenSteps: expected false unless \"lines\" and \"tethers\" are true (it "
-              "projects the tethers between the line solve's steps), got true")
-        << off;
+            "s.json: solver.stretchSolver: expected one of \"gauss-seidel\" \"lines\", got \"jacobi\"");
+  // The key it replaced, and the four it took the place of with maxStretch, say what to write instead.
+  json old = minimal();
+  applyOverride(old, "solver.lines=true");
+  EXPECT_EQ(errorOf([&] { parseScene(old, "s.json"); }),
+            "s.json: solver.lines: expected \"stretchSolver\": \"lines\" or \"gauss-seidel\" instead, got true");
+  for (const char* key : {"geometricStiffness", "tethersBetweenSteps", "extraLineSteps", "stretchTolerance"}) {
+    json older = minimal();
+    applyOverride(older, std::string("solver.") + key + "=1");
+    EXPECT_EQ(errorOf([&] { parseScene(older, "s.json"); }),
+              std::string("s.json: solver.") + key +
+                  ": expected \"maxStretch\" instead (the engine picks what works to it: docs/scenes.md), got 1");
   }
 }
 
-TEST(SceneReader, ExtraLineStepsNeedLinesAndAToleranceInRange) {
+TEST(SceneReader, AStretchTargetNeedsTheLinesARigidClothAndARange) {
   json document = minimal();
-  applyOverride(document, "solver.lines=true");
-  applyOverride(document, "solver.extraLineSteps=3");
-  applyOverride(document, "solver.stretchTolerance=0.02");
-  const sim::SolverSettings solver = parseScene(document, "s.json").world.solver;
-  EXPECT_EQ(solver.extraLineSteps, 3);
-  EXPECT_DOUBLE_EQ(solver.stretchTolerance, 0.02);
-  EXPECT_EQ(parseScene(minimal(), "s.json").world.solver.extraLineSteps, 0);
+  applyOverride(document, "solver.stretchSolver=\"lines\"");
+  applyOverride(document, "solver.maxStretch=0.02");
+  EXPECT_DOUBLE_EQ(parseScene(document, "s.json").world.solver.maxStretch, 0.02);
+  EXPECT_EQ(parseScene(minimal(), "s.json").world.solver.maxStretch, 0.0);
   json without = document;
-  applyOverride(without, "solver.lines=false");
+  applyOverride(without, "solver.stretchSolver=\"gauss-seidel\"");
   EXPECT_EQ(errorOf([&] { parseScene(without, "s.json"); }),
-            "s.json: solver.extraLineSteps: expected 0 unless \"lines\" is true (it adds steps to the line solve), "
-            "got 3");
-  json negative = document;
-  applyOverride(negative, "solver.stretchTolerance=-0.1");
-  EXPECT_NE(errorOf([&] { parseScene(negative, "s.json"); }).find("s.json: solver.stretchTolerance: "),
-            std::string::npos);
-  json many = document;
-  applyOverride(many, "solver.extraLineSteps=101");
-  EXPECT_NE(errorOf([&] { parseScene(many, "s.json"); }).find("s.json: solver.extraLineSteps: "), std::string::npos);
-  json loose = document;
-  applyOverride(loose, "solver.stretchTolerance=11");
-  EXPECT_NE(errorOf([&] { parseScene(loose, "s.json"); }).find("s.json: solver.stretchTolerance: "), std::string::npos);
-  // The force model has no lines: the key is refused there, and dropped when a scene switches to it.
+            "s.json: solver.maxStretch: expected 0 unless \"stretchSolver\" is \"lines\" (the line solve works to "
+            "it), got 0.02");
+  json compliant = document;
+  applyOverride(compliant, "solver.xpbd=true");
+  EXPECT_EQ(errorOf([&] { parseScene(compliant, "s.json"); }),
+            "s.json: solver.maxStretch: expected 0 with \"xpbd\" (a compliant cloth stretches as its compliance says, "
+            "not to a target), got 0.02");
+  for (const char* value : {"-0.1", "1.5"}) {
+    json out = document;
+    applyOverride(out, std::string("solver.maxStretch=") + value);
+    EXPECT_NE(errorOf([&] { parseScene(out, "s.json"); }).find("s.json: solver.maxStretch: "), std::string::npos)
+        << value;
+  }
+  // The force model has no lines: the keys are refused there, and dropped when a scene switches to it.
   json force = minimal();
   applyOverride(force, "solver.model=force");
-  applyOverride(force, "solver.extraLineSteps=2");
-  EXPECT_NE(errorOf([&] { parseScene(force, "s.json"); }).find("s.json: solver.extraLineSteps: "), std::string::npos);
+  applyOverride(force, "solver.stretchSolver=\"lines\"");
+  EXPECT_NE(errorOf([&] { parseScene(force, "s.json"); }).find("s.json: solver.stretchSolver: "), std::string::npos);
   const Scene switched = withModel(parseScene(document, "s.json"), sim::Model::force, sim::Integrator::verlet);
-  EXPECT_EQ(switched.world.solver.extraLineSteps, 0);
-  EXPECT_EQ(switched.document.find("extraLineSteps"), std::string::npos);
-  EXPECT_EQ(switched.document.find("stretchTolerance"), std::string::npos);
+  EXPECT_EQ(switched.world.solver.maxStretch, 0.0);
+  EXPECT_EQ(switched.world.solver.stretchSolver, sim::StretchSolver::gaussSeidel);
+  EXPECT_EQ(switched.document.find("maxStretch"), std::string::npos);
+  EXPECT_EQ(switched.document.find("stretchSolver"), std::string::npos);
 }
 
 TEST(Scene, SwitchingToTheForceModelTakesTheSubstepsItsSpringsNeed) {
@@ -463,7 +455,7 @@ TEST(Snapshot, AClothFarFromTheOriginComesBackOffsetForOffsetAndRunsOnBitForBit)
   for (const std::vector<std::string>& overrides :
        {std::vector<std::string>{far, "tearing.threshold=1.03"}, std::vector<std::string>{far, "solver.tethers=true"},
         std::vector<std::string>{far, "tearing.threshold=1.03", "solver.tethers=true"},
-        std::vector<std::string>{far, "tearing.threshold=1.03", "solver.lines=true"}}) {
+        std::vector<std::string>{far, "tearing.threshold=1.03", "solver.stretchSolver=\"lines\""}}) {
     SCOPED_TRACE(overrides[1]);
     const Scene scene = loadScene(resolveScenePath("hang2-tear"), overrides);
     sim::World world(scene.world);

@@ -33,22 +33,17 @@ struct Row {
   std::string scene;
   int n = 0;  // hang2's N, 0 for other scenes
   bench::Measurement m;
-  bool tethersBetweenSteps = false;  // Drape's sweep on hang2
 };
 
-// One sweep of Drape's hang2 solver tried in the search: substeps, tethers between the line steps,
-// and the worst strain after any frame.
+// One sweep of Drape's hang2 solver tried in the search: substeps, and the worst strain after any
+// frame.
 struct Trial {
   int substeps;
-  bool tethersBetweenSteps;
   double worst;
 };
 
-// "2 x 1", with a mark where the tethers are projected between the line steps.
-std::string sweeps(const Row& row) {
-  return std::to_string(row.m.substeps) + " x " + std::to_string(row.m.iterations) +
-         (row.tethersBetweenSteps ? " (t)" : "");
-}
+// "2 x 1": substeps x sweeps.
+std::string sweeps(const Row& row) { return std::to_string(row.m.substeps) + " x " + std::to_string(row.m.iterations); }
 
 std::string cpuName() {
   std::ifstream cpuinfo("/proc/cpuinfo");
@@ -151,27 +146,19 @@ int bench(const BenchArguments& input) {
     std::vector<std::pair<int, std::vector<Trial>>> searches;  // N: the sweeps tried
     for (int n : arguments.sizes) {
       bench::Hang2Solver solver;
-      solver.extraLineSteps = arguments.extraLineSteps;
+      solver.maxStretch = arguments.maxStretch;
       if (arguments.substeps > 0) {
         solver.substeps = arguments.substeps;
-        solver.tethersBetweenSteps = arguments.tethersBetweenSteps;
       } else {
-        // The cheapest sweep that keeps every structural edge within 5 % at every frame: for each
-        // substep count, the sweep as it is, then with the tethers between the line steps (about a
-        // quarter dearer, so cheaper than one substep more).
+        // The cheapest sweep that keeps every structural edge within 5 % at every frame.
         std::vector<Trial> tried;
         for (int substeps : kSubstepChoices) {
-          for (bool between : {false, true}) {
-            solver.substeps = substeps;
-            solver.tethersBetweenSteps = between;
-            const bench::Measurement probe = bench::measureWorld(bench::hang2(n, solver), arguments.frames, 1, 1);
-            tried.push_back({substeps, between, probe.diverged ? INFINITY : probe.strainMaxRun});
-            if (!arguments.quiet) {
-              std::printf("hang2 %d: %d substeps%s: worst strain %.2f %%\n", n, substeps,
-                          between ? ", tethers between steps" : "", 100.0 * tried.back().worst);
-              std::fflush(stdout);
-            }
-            if (tried.back().worst <= kStrainTarget) break;
+          solver.substeps = substeps;
+          const bench::Measurement probe = bench::measureWorld(bench::hang2(n, solver), arguments.frames, 1, 1);
+          tried.push_back({substeps, probe.diverged ? INFINITY : probe.strainMaxRun});
+          if (!arguments.quiet) {
+            std::printf("hang2 %d: %d substeps: worst strain %.2f %%\n", n, substeps, 100.0 * tried.back().worst);
+            std::fflush(stdout);
           }
           if (tried.back().worst <= kStrainTarget) break;
         }
@@ -179,8 +166,7 @@ int bench(const BenchArguments& input) {
       }
       const sim::WorldSettings world = bench::hang2(n, solver);
       for (int t : arguments.threads) {
-        rows.push_back({"hang2", n, bench::measureWorld(world, arguments.frames, t, arguments.repeats),
-                        world.solver.tethersBetweenSteps});
+        rows.push_back({"hang2", n, bench::measureWorld(world, arguments.frames, t, arguments.repeats)});
         progress(rows.back());
       }
       for (int it : arguments.naiveIterations) {
@@ -211,7 +197,7 @@ int bench(const BenchArguments& input) {
 
     std::ostringstream csv;
     csv << "scene,n,particles,solver,threads,substeps,iterations,ms_per_frame,ms_per_frame_min,projections_per_s,"
-           "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle,tethers_between_steps,"
+           "strain_max_end,strain_mean_end,strain_max_run,diverged,bytes,bytes_per_particle,"
            "extra_line_steps_per_frame\n";
     for (const Row& row : rows) {
       const bench::Measurement& m = row.m;
@@ -220,13 +206,17 @@ int bench(const BenchArguments& input) {
           << ',' << m.strainMaxEnd << ',' << m.strainMeanEnd << ',' << m.strainMaxRun << ',' << (m.diverged ? 1 : 0)
           << ',' << m.bytes << ','
           << static_cast<double>(m.bytes) / static_cast<double>(std::max<std::size_t>(m.particles, 1)) << ','
-          << (row.tethersBetweenSteps ? 1 : 0) << ',' << m.extraLineSteps << '\n';
+          << m.extraLineSteps << '\n';
     }
 
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     const double peakMiB = static_cast<double>(usage.ru_maxrss) / 1024.0;
 
+    // hang2's target for the line solve (the scene file's, or --max-stretch).
+    bench::Hang2Solver asked;
+    asked.maxStretch = arguments.maxStretch;
+    const double maxStretch = bench::hang2(2, asked).solver.maxStretch;
     std::ostringstream report;
     const bool native = std::string(kBuildDescription).find("native:") != std::string::npos;
     report << "# Performance" << (native ? " (a build for this CPU)" : "") << "\n\n"
@@ -245,17 +235,16 @@ int bench(const BenchArguments& input) {
            << "## hang2\n\n"
            << "An N x N sheet, 1 m square in the x-z plane, 1 kg, pinned at two corners, structural + shear + bend "
               "(all rigid), gravity, dt = 1/60 s: it falls and swings from its two corners. Drape solves it with "
-              "tethers to the pins and each row and column of stretch constraints solved at once, the first of "
-              "a sweep's two Newton steps with the links' geometric stiffness where a line is taut (`lines`, "
-              "`geometricStiffness`), in "
-              "substeps of one sweep (how many for each N is below). Where marked (t) the sweep projects the tethers "
-              "again after each of the two Newton steps, and both are full ones (`tethersBetweenSteps`). "
-           << (arguments.extraLineSteps > 0
-                   ? "Where an edge is still more than " + percent(bench::hang2(2).solver.stretchTolerance) +
-                         " long after them, the sweep takes up to " + std::to_string(arguments.extraLineSteps) +
-                         " more line steps (`extraLineSteps`, `stretchTolerance`); \"extra steps\" counts them per "
-                         "frame. "
-                   : std::string("The sweep takes no extra line steps (`--extra-line-steps 0`). "))
+              "tethers to the pins and each row and column of stretch constraints solved at once "
+              "(`\"stretchSolver\": \"lines\"`), in substeps of one sweep (how many for each N is below)"
+           << (maxStretch > 0.0
+                   ? ", working to `\"maxStretch\": " + format("%g", maxStretch) +
+                         "`: the sweep's two Newton steps take the links' geometric stiffness where a line is taut, "
+                         "the tethers are projected again after each, and where an edge is still more than " +
+                         percent(maxStretch) + " long after them the sweep takes up to " +
+                         std::to_string(sim::kExtraLineSteps) + " more steps; \"extra steps\" counts them per frame. "
+                   : std::string(
+                         ", with no stretch target (`--max-stretch 0`): plain Newton steps and no extra ones. "))
            << "The naive "
               "baseline is the textbook loop: an array of particle structs, "
               "Verlet, then Gauss-Seidel sweeps over every constraint in lattice order (`engine/bench/src/naive.cpp`). "
@@ -278,13 +267,11 @@ int bench(const BenchArguments& input) {
       report << "\nDrape's sweep for each N is the cheapest that keeps every structural edge within "
              << percent(kStrainTarget) << " of its rest length after every frame: for each number of substeps (of ";
       for (std::size_t i = 0; i < std::size(kSubstepChoices); ++i) report << (i ? ", " : "") << kSubstepChoices[i];
-      report << "), one sweep each, first as it is, then with the tethers between the line steps (t), which costs "
-                "about a quarter more per substep; the runs tried:\n\n";
+      report << "), one sweep each; the runs tried:\n\n";
       for (const auto& [n, tried] : searches) {
         report << "- N = " << n << ":";
         for (const Trial& trial : tried) {
-          report << " " << trial.substeps << " substeps" << (trial.tethersBetweenSteps ? " (t)" : "") << ", worst "
-                 << percent(trial.worst) << ";";
+          report << " " << trial.substeps << " substeps, worst " << percent(trial.worst) << ";";
         }
         if (!tried.empty() && !(tried.back().worst <= kStrainTarget)) report << " none held: the last one is timed;";
         report << "\n";

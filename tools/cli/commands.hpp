@@ -87,8 +87,7 @@ struct BenchArguments {
   int frames = 120;
   int repeats = 5;                   // timed runs (median); fewer once a case has taken 20 s
   int substeps = 0;                  // Drape's hang2 substeps (of one sweep); 0: the cheapest sweep within 5 % strain
-  bool tethersBetweenSteps = false;  // with substeps: Drape's sweep projects the tethers after each line step
-  int extraLineSteps = 4;            // Drape's sweep: up to this many more line steps where an edge is over 4 %
+  std::optional<double> maxStretch;  // Drape's hang2 sweep works to this (solver.maxStretch); unset: the scene's
   bool quick = false;  // a smoke test: small sizes, few frames (main.cpp applies it to the options not given)
   std::string outDir = "performance";
   std::optional<std::string> report;

@@ -140,7 +140,7 @@ int fabric(const FabricArguments& arguments) {
            << "theta, solved by shooting), and beside it through Peirce's formula. Error: the elastica's c against\n"
            << "(B / (rho g))^(1/3). Target (issue 24): within 5 % at every spacing and setting. Stretch solver: GS,\n"
            << "the seed's Gauss-Seidel sweep over the links; lines, each row and column solved at once\n"
-           << "(`solver.lines`).\n\n"
+           << "(`\"stretchSolver\": \"lines\"`).\n\n"
            << "| fabric | spacing (mm) | substeps x sweeps, stretch solver | chord (deg) | elastica (deg) | c (mm) | "
               "Peirce c (mm) "
               "| expected c (mm) | error | tip motion in the last frame (mm) | worst strain | run (s) |\n"

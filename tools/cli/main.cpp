@@ -193,16 +193,10 @@ int main(int argc, char** argv) {
       ->transform(kDecimal)
       ->check(CLI::Range(1, 1000));
   benchCommand
-      ->add_flag(
-          "--tethers-between-steps", benchArguments.tethersBetweenSteps,
-          "With --substeps: project the tethers again after each of the line solve's steps (tethersBetweenSteps)")
-      ->needs("--substeps");
-  benchCommand
-      ->add_option("--extra-line-steps", benchArguments.extraLineSteps,
-                   "Drape's hang2 sweep: up to this many more line steps where an edge is still over 4 % "
-                   "(extraLineSteps; default 4)")
-      ->transform(kDecimal)
-      ->check(CLI::Range(0, 100));
+      ->add_option("--max-stretch", benchArguments.maxStretch,
+                   "The most a link of hang2 may stretch that Drape's sweep works to, a fraction of its rest length "
+                   "(solver.maxStretch; default hang2.json's; 0: none)")
+      ->check(CLI::Range(0.0, 1.0));
   benchCommand->add_flag("--quick", benchArguments.quick,
                          "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps, touch cases at 8 x 8 for 2 s "
                          "(each unless given)");

@@ -41,7 +41,7 @@ double catenaryError(int links, int iterations, double* strain, bool lines) {
   sim::WorldSettings settings;
   settings.solver.substeps = 4;
   settings.solver.iterations = iterations;
-  settings.solver.lines = lines;
+  settings.solver.stretchSolver = lines ? sim::StretchSolver::lines : sim::StretchSolver::gaussSeidel;
   settings.air.drag = 2.0;
   sim::ClothSettings c = chain(links, length, 0.5, sim::Vec3{-length / 2, top, 0.0});
   c.pins = {{0, 0, sim::Vec3{-span / 2, top, 0.0}}, {links, 0, sim::Vec3{span / 2, top, 0.0}}};

@@ -99,7 +99,7 @@ sim::WorldSettings labWorld(const Spec& spec) {
   settings.solver.substeps = spec.substeps;
   settings.solver.iterations = spec.iterations;
   settings.solver.damping = spec.damping;
-  settings.solver.lines = spec.lines;
+  settings.solver.stretchSolver = spec.lines ? sim::StretchSolver::lines : sim::StretchSolver::gaussSeidel;
   return settings;
 }
 
@@ -119,7 +119,7 @@ SpinResult spin(const SpinSpec& spec) {
   settings.solver.dt = 1.0 / 60.0;
   settings.solver.substeps = spec.substeps;
   settings.solver.iterations = spec.iterations;
-  settings.solver.lines = spec.lines;
+  settings.solver.stretchSolver = spec.lines ? sim::StretchSolver::lines : sim::StretchSolver::gaussSeidel;
   sim::ClothSettings cloth;
   const int cells = std::max(1, static_cast<int>(std::lround(spec.side / spec.spacing)));
   cloth.lattice.columns = cloth.lattice.rows = cells + 1;

@@ -25,12 +25,9 @@ sim::WorldSettings hang2(int n, const Hang2Solver& solver) {
   sim::SolverSettings& s = world.solver;
   s.substeps = solver.substeps.value_or(s.substeps);
   s.iterations = solver.iterations.value_or(s.iterations);
-  s.lines = solver.lines.value_or(s.lines);
+  s.stretchSolver = solver.stretchSolver.value_or(s.stretchSolver);
   s.tethers = solver.tethers.value_or(s.tethers);
-  s.geometricStiffness = solver.geometricStiffness.value_or(s.geometricStiffness);
-  s.tethersBetweenSteps = solver.tethersBetweenSteps.value_or(s.tethersBetweenSteps);
-  s.extraLineSteps = solver.extraLineSteps.value_or(s.extraLineSteps);
-  s.stretchTolerance = solver.stretchTolerance.value_or(s.stretchTolerance);
+  s.maxStretch = solver.maxStretch.value_or(s.maxStretch);
   return world;
 }
 

@@ -259,12 +259,17 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.damping = solver.number("damping", 0.0, {0.0, 1000.0, false, "1/s"});
     world.solver.xpbd = solver.boolean("xpbd", false);
     world.solver.tethers = solver.boolean("tethers", false);
-    world.solver.lines = solver.boolean("lines", false);
-    world.solver.geometricStiffness = solver.boolean("geometricStiffness", false);
-    world.solver.tethersBetweenSteps = solver.boolean("tethersBetweenSteps", false);
-    world.solver.extraLineSteps = solver.integer("extraLineSteps", 0, 0, sim::kMaxExtraLineSteps);
-    world.solver.stretchTolerance =
-        solver.number("stretchTolerance", world.solver.stretchTolerance, {0.0, 10.0, false, ""});
+    // Keys of older scene files, said in the keys that took their place.
+    if (solver.has("lines"))
+      solver.fail("lines", "\"stretchSolver\": \"lines\" or \"gauss-seidel\" instead", solver.raw("lines"));
+    for (const char* old : {"geometricStiffness", "tethersBetweenSteps", "extraLineSteps", "stretchTolerance"}) {
+      if (solver.has(old)) {
+        solver.fail(old, "\"maxStretch\" instead (the engine picks what works to it: docs/scenes.md)", solver.raw(old));
+      }
+    }
+    world.solver.stretchSolver =
+        *sim::parseStretchSolver(solver.choice("stretchSolver", "gauss-seidel", {"gauss-seidel", "lines"}));
+    world.solver.maxStretch = solver.number("maxStretch", 0.0, {0.0, 1.0, false, "fraction of the rest length"});
     // Keys that do not go with the others (the engine's one rule for it: sim::conflict).
     if (const std::optional<sim::SolverConflict> c = sim::conflict(world.solver)) {
       const std::string key(c->key);
@@ -400,11 +405,8 @@ Scene withModel(const Scene& scene, sim::Model model, sim::Integrator integrator
     if (model == Model::force) {
       solverDocument.erase("xpbd");
       solverDocument.erase("tethers");
-      solverDocument.erase("lines");
-      solverDocument.erase("geometricStiffness");
-      solverDocument.erase("tethersBetweenSteps");
-      solverDocument.erase("extraLineSteps");
-      solverDocument.erase("stretchTolerance");
+      solverDocument.erase("stretchSolver");
+      solverDocument.erase("maxStretch");
     }
     if (document.contains("cloths") && document["cloths"].is_array()) {
       for (json& cloth : document["cloths"]) {

@@ -12,6 +12,8 @@ constexpr std::array kIntegratorNames = {std::pair{Integrator::explicitEuler, st
                                          std::pair{Integrator::verlet, std::string_view{"verlet"}},
                                          std::pair{Integrator::midpoint, std::string_view{"midpoint"}},
                                          std::pair{Integrator::rk4, std::string_view{"rk4"}}};
+constexpr std::array kStretchSolverNames = {std::pair{StretchSolver::gaussSeidel, std::string_view{"gauss-seidel"}},
+                                            std::pair{StretchSolver::lines, std::string_view{"lines"}}};
 
 template <typename Table, typename Enum>
 std::string_view lookupName(const Table& table, Enum value) {
@@ -32,7 +34,11 @@ std::optional<Enum> lookupValue(const Table& table, std::string_view text) {
 
 std::string_view name(Model model) { return lookupName(kModelNames, model); }
 std::string_view name(Integrator integrator) { return lookupName(kIntegratorNames, integrator); }
+std::string_view name(StretchSolver solver) { return lookupName(kStretchSolverNames, solver); }
 std::optional<Model> parseModel(std::string_view text) { return lookupValue<Model>(kModelNames, text); }
+std::optional<StretchSolver> parseStretchSolver(std::string_view text) {
+  return lookupValue<StretchSolver>(kStretchSolverNames, text);
+}
 std::optional<Integrator> parseIntegrator(std::string_view text) {
   return lookupValue<Integrator>(kIntegratorNames, text);
 }
@@ -58,32 +64,30 @@ std::optional<SolverConflict> conflict(const SolverSettings& solver) {
     constexpr std::string_view kPositionOnly = "false for the force model (it belongs to the position model)";
     if (solver.xpbd) return SolverConflict{"xpbd", kPositionOnly};
     if (solver.tethers) return SolverConflict{"tethers", kPositionOnly};
-    if (solver.lines) return SolverConflict{"lines", kPositionOnly};
-    if (solver.geometricStiffness) return SolverConflict{"geometricStiffness", kPositionOnly};
-    if (solver.tethersBetweenSteps) return SolverConflict{"tethersBetweenSteps", kPositionOnly};
+    if (solver.lines()) {
+      return SolverConflict{"stretchSolver",
+                            "\"gauss-seidel\" for the force model (\"lines\" belongs to the position model)"};
+    }
+    if (solver.maxStretch > 0.0)
+      return SolverConflict{"maxStretch", "0 for the force model (it belongs to the position model)"};
   }
-  if (solver.extraLineSteps > 0 && !solver.lines) {
-    return SolverConflict{"extraLineSteps", "0 unless \"lines\" is true (it adds steps to the line solve)"};
+  if (solver.maxStretch > 0.0 && !solver.lines()) {
+    return SolverConflict{"maxStretch", "0 unless \"stretchSolver\" is \"lines\" (the line solve works to it)"};
   }
-  if (solver.geometricStiffness && !solver.lines) {
-    return SolverConflict{"geometricStiffness", "false unless \"lines\" is true (it is part of the line solve)"};
-  }
-  if (solver.tethersBetweenSteps && !(solver.lines && solver.tethers)) {
-    return SolverConflict{"tethersBetweenSteps",
-                          "false unless \"lines\" and \"tethers\" are true (it projects the tethers between the "
-                          "line solve's steps)"};
+  if (solver.maxStretch > 0.0 && solver.xpbd) {
+    return SolverConflict{"maxStretch",
+                          "0 with \"xpbd\" (a compliant cloth stretches as its compliance says, not to a target)"};
   }
   return std::nullopt;
 }
 
 SolverSettings consistent(SolverSettings solver) {
   if (solver.model == Model::position) solver.integrator = Integrator::verlet;
-  if (solver.model == Model::force) solver.xpbd = solver.tethers = solver.lines = false;
-  if (!solver.lines) {
-    solver.geometricStiffness = solver.tethersBetweenSteps = false;
-    solver.extraLineSteps = 0;
+  if (solver.model == Model::force) {
+    solver.xpbd = solver.tethers = false;
+    solver.stretchSolver = StretchSolver::gaussSeidel;
   }
-  if (!solver.tethers) solver.tethersBetweenSteps = false;
+  if (!solver.lines() || solver.xpbd) solver.maxStretch = 0.0;
   return solver;
 }
 

@@ -105,10 +105,8 @@ void validate(const WorldSettings& s) {
   require(solver.dt / solver.substeps >= 1e-9, "the substep dt / substeps must be at least 1e-9 s");
   require(solver.iterations >= 0 && solver.iterations <= kMaxIterations, "solver.iterations is out of range");
   require(finite(solver.damping) && solver.damping >= 0.0, "solver.damping must be finite and >= 0");
-  require(solver.extraLineSteps >= 0 && solver.extraLineSteps <= kMaxExtraLineSteps,
-          "solver.extraLineSteps is out of range");
-  require(finite(solver.stretchTolerance) && solver.stretchTolerance >= 0.0,
-          "solver.stretchTolerance must be finite and >= 0");
+  require(finite(solver.maxStretch) && solver.maxStretch >= 0.0 && solver.maxStretch <= 1.0,
+          "solver.maxStretch must be a fraction from 0 to 1");
   if (const std::optional<SolverConflict> c = conflict(solver)) {
     throw std::invalid_argument("solver." + std::string(c->key) + ": " + std::string(c->value));
   }
@@ -382,7 +380,7 @@ void World::buildPipeline() {
 void World::plan(std::size_t c) {
   SolverScratch& scratch = scratch_[c];
   if (scratch.planVersion == topologyVersion_) return;
-  if (settings_.solver.lines) {
+  if (settings_.solver.lines()) {
     // The fast sweep's batches: the constraints are put in batch order, once per topology.
     Cloth& cloth = cloths_[c];
     // A torn cloth's constraints each name their recipe: the names move with them.

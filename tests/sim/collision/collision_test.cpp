@@ -139,7 +139,7 @@ TEST(Drape, AClothDrapedOverABallComesToRestInsteadOfFlippingOnItsSkin) {
   settings.solver.dt = 1.0 / 480.0;
   settings.solver.substeps = 1;
   settings.solver.iterations = 4;
-  settings.solver.lines = true;
+  settings.solver.stretchSolver = StretchSolver::lines;
   settings.solver.damping = 4.0;
   settings.air.drag = 0.3;
   ClothSettings cloth;

@@ -7,9 +7,9 @@
 
 #include <glm/geometric.hpp>
 
-#include "solver/bending.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
+#include "solver/bending.hpp"
 
 namespace drape::sim {
 namespace {
@@ -228,7 +228,7 @@ WorldSettings spinningSheet(Vec3 axis, bool lines = false) {
   settings.solver.dt = 1.0 / 60.0;
   settings.solver.substeps = 4;
   settings.solver.iterations = 8;
-  settings.solver.lines = lines;
+  settings.solver.stretchSolver = lines ? StretchSolver::lines : StretchSolver::gaussSeidel;
   settings.cloths[0].initialSpin = glm::normalize(axis) * (2.0 * std::numbers::pi);
   return settings;
 }

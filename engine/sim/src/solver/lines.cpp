@@ -136,7 +136,8 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
 template <std::size_t W, std::size_t FixedG>
 void solveStiffLines(ParticleState& s, std::size_t count, const std::array<Line, W>& p,
                      const std::array<Real*, W>& lambda, const std::array<float*, W>& tension, bool restart,
-                     std::size_t n, Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows, bool consecutive) {
+                     bool sumTension, std::size_t n, Real stiffness, Real alphaTilde, SolverScratch::StiffRows* rows,
+                     bool consecutive) {
   static_assert(W <= SolverScratch::StiffRows::kLanes && FixedG <= W);
   // Eight lines whose particles at each k are consecutive (p[g][k] = p[0][k] + g) are gathered and
   // scattered eight particles at a time (lines_wide.cpp): the same bits as below.
@@ -225,7 +226,7 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<Line,
       if (j == 0) continue;
       const Real multiplier = static_cast<Real>(r.yl[g]) * multiplierScale[g];
       if (lambda[g]) lambda[g][j - 1] += multiplier;
-      tension[g][j - 1] = static_cast<float>((restart ? 0.0f : tension[g][j - 1]) + multiplier);
+      if (sumTension) tension[g][j - 1] = static_cast<float>((restart ? 0.0f : tension[g][j - 1]) + multiplier);
     }
   }
 }
@@ -517,11 +518,11 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                                for (std::size_t g = 0; consecutive && g + 1 < W; ++g) {
                                  consecutive = ids[g + 1] == ids[g] + 1 && lines.besideNext[ids[g]];
                                }
-                               solveStiffLines<W, W>(s, G, p, lambda, tension, restart, n, stiffness, alpha, rows,
-                                                     consecutive);
+                               solveStiffLines<W, W>(s, G, p, lambda, tension, restart, scratch.sumTension, n,
+                                                     stiffness, alpha, rows, consecutive);
                              } else {
-                               solveStiffLines<W, 0>(s, G, p, lambda, tension, restart, n, stiffness, alpha, rows,
-                                                     false);
+                               solveStiffLines<W, 0>(s, G, p, lambda, tension, restart, scratch.sumTension, n,
+                                                     stiffness, alpha, rows, false);
                              }
                            });
               };
@@ -537,7 +538,7 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                   [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
                                      const auto& offset, std::size_t n) {
                     std::array<float*, G> summed{};
-                    for (std::size_t g = 0; geometricStiffness && g < G; ++g) {
+                    for (std::size_t g = 0; geometricStiffness && scratch.sumTension && g < G; ++g) {
                       summed[g] = lines.tension.data() + offset[g];
                     }
                     Vec3* normal = scratch.lineNormal.data() + slice;

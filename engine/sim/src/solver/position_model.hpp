@@ -42,13 +42,13 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
 //               dx_b = -k w_b / (w_a + w_b) (...)
 // With equal masses and k = 1 that is exactly the seed's dx_1 = 1/2 (|x2 - x1| - r)(x2 - x1)/|x2 - x1|.
 // Each sweep starts with the tethers (scratch.tethers), if any (and projects them again after each
-// of the lines' Newton steps with solver.tethersBetweenSteps). With `colliders`, the contact
+// of the lines' Newton steps where solver.maxStretch says so). With `colliders`, the contact
 // planes are re-enforced after every sweep, so the constraints cannot pull a particle back into a
 // collider, and friction acts there too (contact::friction), so the next sweep sees a stuck particle stay. With
-// solver.xpbd each kind resists with its compliance instead (see settings.hpp); with solver.lines the stretch
-// constraints are solved a line at a time (lines.hpp; scratch.lines built). Batches, lines and tethers are shared among
-// the workers: the result does not depend on how many there are. Each part (tethers, each kind, the loose links, the
-// contact planes) is timed by `parts`.
+// solver.xpbd each kind resists with its compliance instead (see settings.hpp); with the lines stretch solver the
+// stretch constraints are solved a line at a time (lines.hpp; scratch.lines built). Batches, lines and tethers are
+// shared among the workers: the result does not depend on how many there are. Each part (tethers, each kind, the loose
+// links, the contact planes) is timed by `parts`.
 void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch,
                         const std::vector<Collider>& colliders, Workers& workers, PartClock& parts);
 

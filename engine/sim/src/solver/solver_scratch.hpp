@@ -78,7 +78,7 @@ struct SolverScratch {
     void assign(const std::vector<Tether>& tethers);
   };
   Tethers tethers;
-  // Lines (solver.lines): the stretch constraints as chains, rows and columns on a lattice, each
+  // Lines (the lines stretch solver): the stretch constraints as chains, rows and columns on a lattice, each
   // solved at once (lines.hpp). Built from the constraints whenever they change. A line keeps no
   // copy of its particles or rest lengths: lines::build puts the cloth's stretch constraints in line
   // order, each line's links one after another and each link from the line's particle k (its a)
@@ -92,8 +92,9 @@ struct SolverScratch {
     // Line l's first link in the cloth's stretch constraints.
     std::size_t firstLink(std::size_t l) const { return linkBase + start[l] - l; }
     std::vector<Real> lambda;  // XPBD: multiplier of link k, reset each substep
-    // solver.geometricStiffness: the sum of link k's multipliers (its tension times h^2, negative
-    // when pulled) over this substep's steps so far, or before its first, over the last substep's.
+    // With geometric stiffness (solver.maxStretch): the sum of link k's multipliers (its tension
+    // times h^2, negative when pulled) over this substep's first sweep so far, or before its first
+    // step, over the last substep's first sweep.
     // The first step reads it and starts it again (fresh). Single precision: it only scales the
     // geometric stiffness, and chooses which lines take the full step.
     std::vector<float> tension;
@@ -110,10 +111,13 @@ struct SolverScratch {
     std::size_t tautCount = 0;
     bool ordered = false;
   };
-  // solver.geometricStiffness: a line takes the full Newton step where its geometric stiffness
+  // With geometric stiffness: a line takes the full Newton step where its geometric stiffness
   // reaches this fraction of its particles' mass somewhere, else the tridiagonal one (lines.cpp,
   // needsFullStep). 0: every line with a link that is not pushed.
   Real fullStepRatio = 0.1;
+  // Whether this sweep's line steps add their multipliers to the lines' tension: the substep's
+  // first sweep only (position_model.cpp, projectConstraints).
+  bool sumTension = true;
   std::array<LineFamily, 2> lines;          // along x, and across
   std::vector<std::uint32_t> looseStretch;  // stretch constraints in no line: solved one by one
   // Working arrays of the line solves, as long as the longest line, one slice per thread.
@@ -149,7 +153,7 @@ struct SolverScratch {
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;
   std::array<bool, kConstraintKindCount> sequentialTail{};
   std::uint64_t planVersion = 0;    // the world's topology version the batches and lines were made for
-  std::int64_t extraLineSteps = 0;  // line steps taken beyond a sweep's two (solver.extraLineSteps)
+  std::int64_t extraLineSteps = 0;  // line steps taken beyond a sweep's two (solver.maxStretch)
 };
 
 // The self-collision spatial hash over every particle of a world.

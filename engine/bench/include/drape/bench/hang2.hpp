@@ -15,12 +15,9 @@ namespace drape::bench {
 struct Hang2Solver {
   std::optional<int> substeps;
   std::optional<int> iterations;
-  std::optional<bool> lines;
+  std::optional<sim::StretchSolver> stretchSolver;
   std::optional<bool> tethers;
-  std::optional<bool> geometricStiffness;
-  std::optional<bool> tethersBetweenSteps;
-  std::optional<int> extraLineSteps;
-  std::optional<double> stretchTolerance;
+  std::optional<double> maxStretch;
 };
 
 // The scene file's hang2 at N x N (N from 2), with `solver`'s changes.

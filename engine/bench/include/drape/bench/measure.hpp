@@ -43,7 +43,7 @@ struct Measurement {
   double strainMeanEnd = 0.0;
   double strainMaxRun = 0.0;    // worst structural strain after any frame
   bool diverged = false;        // non-finite (naive) or stopped by the guard (drape)
-  double extraLineSteps = 0.0;  // drape: line steps a frame took beyond its sweeps' two (solver.extraLineSteps)
+  double extraLineSteps = 0.0;  // drape: line steps a frame took beyond its sweeps' two (solver.maxStretch)
   std::size_t bytes = 0;        // what the solver keeps for the cloth: state, rest data, constraints, scratch
   std::vector<std::pair<std::string, std::size_t>> bytesBy;  // drape: the same by what it is for
   // drape: ms per frame in each pipeline stage, then "(step)": the whole step, stages and the rest

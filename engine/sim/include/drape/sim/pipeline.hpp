@@ -41,10 +41,10 @@ enum class Stage : std::uint8_t {
   plan,           // the solver's plan of a cloth, where its mesh or settings changed (batches, lines)
   tethers,        // each particle into reach of the pins (long-range attachments)
   bendStencils,   // a fabric's bending (its stencils, solved as one block)
-  bend,           // the bend constraints (in batches with solver.lines)
+  bend,           // the bend constraints (in batches with the lines stretch solver)
   shear,          // the shear constraints (likewise)
-  stretch,        // the stretch constraints (whole lines at a time with solver.lines)
-  looseLinks,     // with solver.lines: the stretch links on no line, one at a time
+  stretch,        // the stretch constraints (whole lines at a time with the lines stretch solver)
+  looseLinks,     // with the lines stretch solver: the stretch links on no line, one at a time
   contactPlanes,  // each particle back onto its collider contacts' planes, after each sweep
   // parts of selfContact (friction, above, is its part too)
   broadPhase,    // the vertex-triangle and edge-edge pairs that may come within reach (a tree of boxes)

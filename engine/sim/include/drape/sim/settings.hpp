@@ -28,10 +28,24 @@ enum class Integrator : std::uint8_t {
   rk4,              // classical Runge-Kutta                              (fourth order)
 };
 
+// How the position model solves the stretch (structural) constraints.
+enum class StretchSolver : std::uint8_t {
+  // The seed's sweep: one constraint at a time, each corrected as the ones before it left the
+  // cloth (Gauss-Seidel).
+  gaussSeidel,
+  // Each row and column of stretch constraints at once, exactly for its linearised constraints (a
+  // tridiagonal system, as Goldenthal et al. 2007 do for the whole cloth), two Newton steps a
+  // sweep, after tethers, bend and shear in batches shared among the threads (the fast sweep): a
+  // sweep carries a correction along the whole line, where Gauss-Seidel carries it one particle.
+  lines,
+};
+
 std::string_view name(Model model);
 std::string_view name(Integrator integrator);
+std::string_view name(StretchSolver solver);
 std::optional<Model> parseModel(std::string_view text);
 std::optional<Integrator> parseIntegrator(std::string_view text);
+std::optional<StretchSolver> parseStretchSolver(std::string_view text);
 
 struct SolverSettings {
   Model model = Model::position;
@@ -47,40 +61,31 @@ struct SolverSettings {
   // Position model: long-range attachments (Kim, Chentanez, Mueller 2012): no particle may be
   // farther from a pin than it is at rest. One cheap inequality per particle and pin.
   bool tethers = false;
-  // Position model: each row and column of stretch constraints is solved at once, exactly for its
-  // linearised constraints (a tridiagonal system, as Goldenthal et al. 2007 do for the whole
-  // cloth), instead of one constraint at a time. A sweep then carries a correction along the whole
-  // line, where Gauss-Seidel carries it one particle.
-  bool lines = false;
-  // Position model, with lines: each line's solve is a full Newton step of its projection, the
-  // links' geometric stiffness (their tension over their length, from the last substep) included
-  // (Tournier et al. 2015, Andrews et al. 2017). Without it a taut line's sideways kinks are
-  // stepped explicitly, and grow unless the substep is shorter than a wave takes to cross a link;
-  // with it the substeps a stiff cloth needs no longer grow with its resolution.
-  bool geometricStiffness = false;
-  // Position model, with lines and tethers: the tethers are projected again after each of the line
-  // solve's two Newton steps, and with geometric stiffness both steps are full. A tether's pull and
-  // the lines' lengths then settle together within a sweep instead of across substeps: a fine
-  // stiff cloth hanging from pins needs half the substeps or fewer, each about a quarter dearer.
-  bool tethersBetweenSteps = false;
-  // Position model, with lines: after a sweep's line steps, while some line's link that a step can
-  // move (not one between two pinned or held particles) is longer than (1 + stretchTolerance)
-  // times its rest length, one more Newton step of every line (full with geometric stiffness, and
-  // the tethers after it with tethersBetweenSteps), at most extraLineSteps times a sweep. A frame
-  // that jerks the cloth (the first fall, a finger's yank) pays for the steps it needs; the others
-  // pay one pass that checks. 0: never.
-  int extraLineSteps = 0;
-  Real stretchTolerance = 0.04;
+  // Position model: how the stretch constraints are solved (StretchSolver).
+  StretchSolver stretchSolver = StretchSolver::gaussSeidel;
+  // Position model, with lines: the most a structural link may stretch, a fraction of its rest
+  // length (0.04: 4 % long), that the solver works to; 0: no target, the sweeps do what they do.
+  // With a target the engine picks what gets there (docs/scenes.md, position_model.cpp's
+  // StretchPlan): each line's step includes its links' geometric stiffness where the line is taut
+  // (Tournier et al. 2015, Andrews et al. 2017: a taut line's sideways kinks then cannot grow, so a
+  // fine stiff cloth needs no more substeps than a coarse one); with tethers, they are projected
+  // again after each line step, so that a tether's pull and the lines' lengths settle within a
+  // sweep; and a sweep takes up to kExtraLineSteps more steps while a link a step can move is over
+  // the target. A frame that jerks the cloth pays for the steps it needs; the others pay one check.
+  // A compliant cloth (xpbd, or a fabric) stretches as its material says: the target leaves it as
+  // it is.
+  Real maxStretch = 0.0;
+
+  bool lines() const { return stretchSolver == StretchSolver::lines; }
 };
 
 // Which solver keys go together, said once, for the scene reader, the panels, a change of model
 // and the world (which refuses settings that break it): the force model has none of xpbd, tethers,
-// lines, geometricStiffness, tethersBetweenSteps and extraLineSteps (they belong to the position
-// model) and the position model only the "verlet" integrator; geometricStiffness and
-// extraLineSteps need lines, tethersBetweenSteps lines and tethers.
+// the lines stretch solver and maxStretch (they belong to the position model) and the position
+// model only the "verlet" integrator; maxStretch needs the lines and not xpbd.
 struct SolverConflict {
   std::string_view key;    // the key that does not go with the others, as scene files spell it
-  std::string_view value;  // what it must be, and why: false unless "lines" is true (...)
+  std::string_view value;  // what it must be, and why: 0 unless "stretchSolver" is "lines" (...)
 };
 // The first key that does not go with the others, in the order above; none if they all do.
 std::optional<SolverConflict> conflict(const SolverSettings& solver);
@@ -203,7 +208,8 @@ inline constexpr int kMaxLatticeSide = 4096;
 inline constexpr long long kMaxParticles = 1 << 20;  // over all cloths of a world
 inline constexpr int kMaxSubsteps = 1000;
 inline constexpr int kMaxIterations = 10000;
-inline constexpr int kMaxExtraLineSteps = 100;
+// With solver.maxStretch: the most line steps a sweep takes beyond its two while a link is over it.
+inline constexpr int kExtraLineSteps = 4;
 // A particle farther than this from the origin is a runaway: the guard treats it like NaN.
 inline constexpr Real kRunawayDistance = 1.0e6;  // m
 inline constexpr Real kRunawaySpeed = 1.0e6;     // m/s, likewise for a stored velocity

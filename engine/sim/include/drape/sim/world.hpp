@@ -99,7 +99,7 @@ inline constexpr int kMaxThreads = 64;
 // finger with every other (pinch-lift) stays cheap.
 inline constexpr int kMaxFingers = 256;
 
-// How many lines the full Newton line step (solver.geometricStiffness) solves side by side on this
+// How many lines the full Newton line step (with solver.maxStretch) solves side by side on this
 // CPU: 8 where it has AVX (chosen at run time, in the portable build too), else 4. The results are
 // the same bit for bit either way.
 int stiffSolveLanes();
@@ -121,9 +121,8 @@ class World {
   std::size_t memoryBytes() const;
   MemoryUse memoryUse() const;
   std::size_t tetherCount() const;
-  // Line steps the sweeps of the cloths there are now have taken beyond their two, because the
-  // cloth was stretched beyond solver.stretchTolerance (solver.extraLineSteps), since the world was
-  // made or its cloths replaced.
+  // Line steps the sweeps of the cloths there are now have taken beyond their two, because a
+  // cloth was stretched beyond solver.maxStretch, since the world was made or its cloths replaced.
   std::int64_t extraLineSteps() const;
 
   // One step. If it leaves a position non-finite or beyond kRunawayDistance (the guard stage), the
