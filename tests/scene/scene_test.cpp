@@ -521,6 +521,54 @@ TEST(Snapshot, ATetheredClothPinnedAndUnpinnedByHandRunsOnBitForBit) {
   EXPECT_TRUE(loaded.cloths()[0].state.position == world.cloths()[0].state.position);
 }
 
+TEST(Snapshot, ASheetWorkingToAStretchTargetRunsOnBitForBitWithItsLinksTension) {
+  // hang2 at 32 x 32 working to 4 %: the next step's geometric stiffness reads the tension the last
+  // one summed (Cloth::stretchTension), so the snapshot keeps it. Loaded without it, the sheet goes
+  // on otherwise: the tension is what makes the two the same.
+  const Scene scene = loadScene(resolveScenePath("hang2"), {"cloths.0.grid.columns=32", "cloths.0.grid.rows=32",
+                                                            "cloths.0.pins.1.particle=[31,0]"});
+  ASSERT_GT(scene.world.solver.maxStretch, 0.0);
+  sim::World world(scene.world);
+  ASSERT_EQ(world.run(30), sim::StepStatus::ok);
+  ASSERT_EQ(world.cloths()[0].stretchTension.size(), world.cloths()[0].rest.of(sim::ConstraintKind::stretch).size());
+  const json document = snapshotDocument(scene, world);
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("drape-taut-" + std::to_string(::getpid()) + ".drape.json");
+  const auto loaded = [&](const json& written) {
+    writeFileAtomically(file, written.dump());
+    sim::World back = makeWorld(loadSnapshot(file));
+    std::filesystem::remove(file);
+    return back;
+  };
+  sim::World with = loaded(document);
+  json stripped = document;
+  stripped["cloths"][0].erase("stretchTension");
+  sim::World without = loaded(stripped);
+  EXPECT_EQ(with.cloths()[0].stretchTension, world.cloths()[0].stretchTension);
+  for (int step = 0; step < 10; ++step) {
+    ASSERT_EQ(world.step(), sim::StepStatus::ok);
+    ASSERT_EQ(with.step(), sim::StepStatus::ok);
+    ASSERT_EQ(without.step(), sim::StepStatus::ok);
+  }
+  EXPECT_TRUE(with.cloths()[0].state.position == world.cloths()[0].state.position);
+  EXPECT_FALSE(without.cloths()[0].state.position == world.cloths()[0].state.position);
+  // One entry per stretch constraint, each a finite number a float holds.
+  for (const auto& [bad, what] : {std::pair{json::array({-1.0, 2.0}), "one entry per stretch constraint"},
+                                  std::pair{json(), "a finite number of N s^2"}}) {
+    json broken = document;
+    if (bad.is_null()) {
+      broken["cloths"][0]["stretchTension"][3] = 1e39;
+    } else {
+      broken["cloths"][0]["stretchTension"] = bad;
+    }
+    writeFileAtomically(file, broken.dump());
+    const std::string error = errorOf([&] { loadSnapshot(file); });
+    std::filesystem::remove(file);
+    EXPECT_NE(error.find("cloths.0.stretchTension"), std::string::npos) << error;
+    EXPECT_NE(error.find(what), std::string::npos) << error;
+  }
+}
+
 TEST(Snapshot, ARestPositionSinglePrecisionCannotHoldIsRefusedByName) {
   const Scene scene = loadScene(resolveScenePath("hang2-tear"),
                                 {"cloths.0.grid.columns=4", "cloths.0.grid.rows=4", "cloths.0.pins.1.particle=[3,0]"});

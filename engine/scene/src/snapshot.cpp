@@ -1,6 +1,7 @@
 #include "drape/scene/snapshot.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
@@ -75,6 +76,9 @@ json snapshotDocument(const Scene& scene, const sim::World& world) {
     }
     c["pinned"] = std::move(pinned);
     c["tetherPins"] = cloth.tetherPins;
+    // With a stretch target, the links' tension the next step's geometric stiffness reads (floats:
+    // a double holds each exactly, and reads back the same).
+    if (!cloth.stretchTension.empty()) c["stretchTension"] = cloth.stretchTension;
     c["lattice"] = {cloth.rest.columns, cloth.rest.rows};
     cloths.push_back(std::move(c));
   }
@@ -160,6 +164,21 @@ Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source
     } else {
       for (std::uint32_t p = 0; p < n; ++p) {
         if (s.pinned[p]) cloth.tetherPins.push_back(p);
+      }
+    }
+    if (reader.has("stretchTension")) {
+      cloth.stretchTension = tuples<float>(reader, "stretchTension", 1, "a finite number of N s^2, as a float holds it",
+                                           [](const json& t) -> std::optional<float> {
+                                             if (!t.is_number()) return std::nullopt;
+                                             const double v = t.get<double>();
+                                             if (!(std::abs(v) <= std::numeric_limits<float>::max()))
+                                               return std::nullopt;
+                                             return static_cast<float>(v);
+                                           });
+      const std::size_t links = cloth.rest.of(sim::ConstraintKind::stretch).size();
+      if (cloth.stretchTension.size() != links) {
+        reader.fail("stretchTension", "one entry per stretch constraint (" + std::to_string(links) + ")",
+                    reader.raw("stretchTension"));
       }
     }
     s.inverseMass.assign(n, 0.0);

@@ -434,6 +434,7 @@ MemoryUse World::memoryUse() const {
     const ParticleState& s = cloth.state;
     m.state += bytes(s.position) + bytes(s.previousPosition) + bytes(s.velocity) + bytes(s.inverseMass) +
                bytes(s.mass) + bytes(s.pinned);
+    m.lines += bytes(cloth.stretchTension);
     const Topology& t = cloth.topology;
     m.topology += bytes(t.neighbour) + bytes(t.triangleArea) + bytes(t.templates) + bytes(t.source) +
                   bytes(t.restFrames) + bytes(cloth.piece);
@@ -448,8 +449,7 @@ MemoryUse World::memoryUse() const {
                 bytes(s.bendingFactor.rank);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
-      m.lines +=
-          bytes(f.start) + bytes(f.lambda) + bytes(f.tension) + bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
+      m.lines += bytes(f.start) + bytes(f.lambda) + bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
     }
   }
   for (const std::vector<Vec3>& good : lastGood_) m.guard += bytes(good);
@@ -934,6 +934,7 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
                                 const std::vector<ParticleInsert>& inserted) {
   Cloth& cloth = cloths_[c];
   const std::size_t n = cloth.state.position.size();
+  cloth.stretchTension.clear();  // its links were split or re-pointed: the tension builds again
   if (!held_[c].empty()) held_[c].resize(n, 0);
   // A particle a cut put between two particles one finger holds is held by it too, where it lies.
   for (const ParticleInsert& in : inserted) {
@@ -1153,6 +1154,10 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
     }
     for (const ParticleIndex p : cloth.tetherPins)
       require(p < n, "a tether pin names a particle the cloth does not have");
+    require(
+        cloth.stretchTension.empty() || cloth.stretchTension.size() == cloth.rest.of(ConstraintKind::stretch).size(),
+        "a cloth's stretch tension must have one entry per stretch constraint, or none");
+    for (const float t : cloth.stretchTension) require(std::isfinite(t), "a stretch tension is not finite");
     for (const glm::uvec3& t : cloth.rest.triangles) {
       require(t.x < n && t.y < n && t.z < n, "a triangle names a particle the cloth does not have");
       require(t.x != t.y && t.y != t.z && t.z != t.x, "a triangle names one particle twice");

@@ -220,7 +220,7 @@ TEST(SelfContact, AClothOnASlopeOfClothSticksBelowTheFrictionAngleAndSlidesAbove
   EXPECT_NEAR(slideOnClothSlope(steep, 0.7, t), 0.0, 1e-5);
   // Above it, it slides, less far with friction. Not as far as Coulomb says: 80 % of g sin(theta)
   // t^2 / 2 with no friction, 92 % of g (sin(theta) - mu cos(theta)) t^2 / 2 with mu = 0.3
-  // (docs/self-contact.md); each within 25 % here.
+  // (docs/design.md, Known limits); each within 25 % here.
   const Real free = slideOnClothSlope(steep, 0.0, t), rubbed = slideOnClothSlope(steep, 0.3, t);
   EXPECT_NEAR(free, 0.5 * 9.81 * std::sin(steep) * t * t, 0.25 * 0.5 * 9.81 * std::sin(steep) * t * t);
   const Real coulomb = 0.5 * 9.81 * (std::sin(steep) - 0.3 * std::cos(steep)) * t * t;

@@ -182,10 +182,10 @@ TEST(Lines, OnlyATautLineTakesTheFullNewtonStep) {
     SolverScratch scratch;
     lines::build(cloth, scratch, 1);
     SolverScratch::LineFamily& line = scratch.lines[0];
-    line.tension.resize(line.slots());
+    cloth.stretchTension.resize(cloth.rest.of(ConstraintKind::stretch).size());
     const DistanceConstraint* link = cloth.rest.of(ConstraintKind::stretch).data() + line.firstLink(0);
     for (std::size_t k = 0; k + 1 < line.slots(); ++k) {
-      line.tension[k] =
+      cloth.stretchTension[line.firstLink(0) + k] =
           static_cast<float>(-ratio * scratch.fullStepRatio * link[k].restLength * cloth.state.mass[link[k].a]);
     }
     Workers workers(1);
@@ -221,17 +221,13 @@ TEST(Lines, TheStiffSolveGivesTheSameBitsEightLinesAtATimeAsFour) {
     scratch.stiffLanes = lanes;
     scratch.fullStepRatio = 0.0;  // every line takes the full step
     std::uniform_real_distribution<float> pull(-2e-4f, 0.0f);
-    for (SolverScratch::LineFamily& family : scratch.lines) {
-      family.tension.resize(family.slots());
-      for (float& t : family.tension) t = pull(random);
-    }
+    cloth.stretchTension.resize(cloth.rest.of(ConstraintKind::stretch).size());
+    for (float& t : cloth.stretchTension) t = pull(random);
     Workers workers(1);
     std::vector<float> tensions;
     for (int sweep = 0; sweep < 2; ++sweep) {
       lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
-      for (const SolverScratch::LineFamily& family : scratch.lines) {
-        tensions.insert(tensions.end(), family.tension.begin(), family.tension.end());
-      }
+      tensions.insert(tensions.end(), cloth.stretchTension.begin(), cloth.stretchTension.end());
       lines::beginSubstep(scratch);
     }
     return std::pair{cloth.state.position, tensions};
@@ -254,7 +250,7 @@ TEST(Lines, TheStiffSolveDoesNotDependOnHowMuchTheClothWeighs) {
     for (Real& w : cloth.state.inverseMass) w /= massScale;
     SolverScratch scratch;
     lines::build(cloth, scratch, 1);
-    scratch.lines[0].tension.assign(scratch.lines[0].slots(), static_cast<float>(-1e-3 * massScale));
+    cloth.stretchTension.assign(cloth.rest.of(ConstraintKind::stretch).size(), static_cast<float>(-1e-3 * massScale));
     Workers workers(1);
     lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
     return cloth.state.position;
@@ -279,7 +275,7 @@ TEST(Lines, UnderTensionAStraightStretchedChainIsStillExactInOneSolve) {
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) cloth.state.position[i].x *= 1.3;
   SolverScratch scratch;
   lines::build(cloth, scratch, 1);
-  scratch.lines[0].tension.assign(scratch.lines[0].slots(), -1e-3f);  // pulled hard
+  cloth.stretchTension.assign(cloth.rest.of(ConstraintKind::stretch).size(), -1e-3f);  // pulled hard
   Workers workers(1);
   lines::solve(cloth, scratch, 1.0, false, 0.0, true, workers, nullptr);
   EXPECT_LT(worstViolation(cloth), 1e-12);
@@ -303,7 +299,8 @@ TEST(Lines, TheTensionIsTheSumOfTheSubstepsMultipliersSoFar) {
     const SolverScratch::LineFamily& family = scratch.lines[0];
     Real largest = 0.0;
     for (std::size_t k = 0; k + 1 < family.slots(); ++k) {
-      EXPECT_NEAR(family.tension[k], family.lambda[k], 1e-6 * std::abs(family.lambda[k]) + 1e-12)
+      EXPECT_NEAR(cloth.stretchTension[family.firstLink(0) + k], family.lambda[k],
+                  1e-6 * std::abs(family.lambda[k]) + 1e-12)
           << "substep " << substep << " link " << k;
       largest = std::max(largest, std::abs(family.lambda[k]));
     }

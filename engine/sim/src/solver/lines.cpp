@@ -231,29 +231,30 @@ void solveStiffLines(ParticleState& s, std::size_t count, const std::array<Line,
   }
 }
 
-// Where lines line[0, G) of a family start (their slots), their links (in `stretch`, the cloth's
-// stretch constraints) and multipliers (null without XPBD), in arrays of N.
+// Lines line[0, G) of a family: their links (in `stretch`, the cloth's stretch constraints), their
+// multipliers (at their slots; null without XPBD) and their first link's index in `stretch` (where
+// their tension is, Cloth::stretchTension), in arrays of N.
 template <std::size_t N>
 struct LineData {
   std::array<Line, N> p{};
   std::array<Real*, N> lambda{};
-  std::array<std::size_t, N> offset{};
+  std::array<std::size_t, N> firstLink{};
 };
 template <std::size_t N>
 LineData<N> lineData(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
                      std::size_t G, bool xpbd) {
   LineData<N> d;
   for (std::size_t g = 0; g < G; ++g) {
-    d.offset[g] = lines.start[line[g]];
-    d.p[g].link = stretch + lines.firstLink(line[g]);
-    d.lambda[g] = xpbd ? lines.lambda.data() + d.offset[g] : nullptr;
+    d.firstLink[g] = lines.firstLink(line[g]);
+    d.p[g].link = stretch + d.firstLink[g];
+    d.lambda[g] = xpbd ? lines.lambda.data() + lines.start[line[g]] : nullptr;
   }
   return d;
 }
 
 // The lines line[0, count) of a family, W at a time where W in a row are equally long (G = W),
-// else one (G = 1): solve(std::integral_constant<std::size_t, G>, lines, lambdas, offsets, n),
-// each array holding G lines' (lambdas null without XPBD) and offsets their slots. A line's arithmetic does not depend
+// else one (G = 1): solve(std::integral_constant<std::size_t, G>, lines, lambdas, firstLinks, n),
+// each array holding G lines' (lambdas null without XPBD; LineData). A line's arithmetic does not depend
 // on which lines it is solved beside. (The vector solve takes up to W in a row instead: inLanes.)
 template <std::size_t W, class Solve>
 void inGroups(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, const std::uint32_t* line,
@@ -262,7 +263,7 @@ void inGroups(SolverScratch::LineFamily& lines, const DistanceConstraint* stretc
   const auto length = [&](std::size_t i) { return lines.start[line[i] + 1] - lines.start[line[i]]; };
   const auto gather = [&]<std::size_t N>(std::integral_constant<std::size_t, N> size, std::size_t i, std::size_t n) {
     const LineData<N> d = lineData<N>(lines, stretch, line + i, N, xpbd);
-    solve(size, d.p, d.lambda, d.offset, n);
+    solve(size, d.p, d.lambda, d.firstLink, n);
   };
   for (std::size_t i = 0; i < count;) {
     const std::size_t n = length(i);
@@ -279,7 +280,7 @@ void inGroups(SolverScratch::LineFamily& lines, const DistanceConstraint* stretc
 }
 
 // The lines line[0, count) of a family, up to W at a time, as many equally long ones as follow
-// each other: solve(G, lines, lambdas, offsets, n, ids), each array holding W lines' of which the
+// each other: solve(G, lines, lambdas, firstLinks, n, ids), each array holding W lines' of which the
 // first G are filled (lambdas null without XPBD), and ids their indices.
 // A lane left empty costs as much as a filled one, so a short group beats lines one by one.
 template <std::size_t W, class Solve>
@@ -295,7 +296,7 @@ void inLanes(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch
     std::size_t G = 1;
     while (G < W && i + G < count && length(i + G) == n) ++G;
     const LineData<W> d = lineData<W>(lines, stretch, line + i, G, xpbd);
-    solve(G, d.p, d.lambda, d.offset, n, line + i);
+    solve(G, d.p, d.lambda, d.firstLink, n, line + i);
     i += G;
   }
 }
@@ -306,10 +307,10 @@ void inLanes(SolverScratch::LineFamily& lines, const DistanceConstraint* stretch
 // of a link the tridiagonal step keeps a kink from growing, and g changes the step by a tenth at
 // most. (hang2 256: most rows are below it, every column above; the strains it reaches do not
 // change. Rest lengths stand in for lengths.)
-bool needsFullStep(const SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, std::size_t l,
-                   const MassReal* mass, Real ratio) {
+bool needsFullStep(const SolverScratch::LineFamily& lines, const DistanceConstraint* stretch,
+                   const float* stretchTension, std::size_t l, const MassReal* mass, Real ratio) {
   const DistanceConstraint* link = stretch + lines.firstLink(l);
-  const float* tension = lines.tension.data() + lines.start[l];
+  const float* tension = stretchTension + lines.firstLink(l);
   for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {
     if (-tension[k] >= ratio * link[k].restLength * mass[link[k].a]) return true;
   }
@@ -415,6 +416,16 @@ void build(Cloth& cloth, SolverScratch& scratch, int threads) {
     for (std::size_t k = 0; k < from.size(); ++k) moved[k] = source[from[k]];
     source.swap(moved);
   }
+  // The tension moves with its constraints too (a snapshot's comes in the order this leaves them
+  // in, and goes on as it was); if it is not one a constraint, it is stale: none.
+  std::vector<float>& tension = cloth.stretchTension;
+  if (tension.size() == from.size()) {
+    std::vector<float> moved(from.size());
+    for (std::size_t k = 0; k < from.size(); ++k) moved[k] = tension[from[k]];
+    tension.swap(moved);
+  } else {
+    tension.clear();
+  }
   stretch.swap(ordered);
   for (SolverScratch::LineFamily& lines : scratch.lines) {
     const std::size_t count = lines.start.size() - 1;
@@ -450,9 +461,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
   if (geometricStiffness) {
     const std::size_t rows = scratch.lineStride / 4 * static_cast<std::size_t>(workers.threads());
     if (scratch.lineStiff.size() < rows) scratch.lineStiff.resize(rows);
-    for (SolverScratch::LineFamily& lines : scratch.lines) {  // sized here alone (zero: no tension yet)
-      lines.tension.resize(lines.slots(), 0.0f);
-    }
+    // Sized here alone (zero: no tension yet); a link on no line keeps a slot it never uses.
+    cloth.stretchTension.resize(cloth.rest.of(ConstraintKind::stretch).size(), 0.0f);
   }
   for (SolverScratch::LineFamily& lines : scratch.lines) {
     if (lines.start.size() < 2) continue;
@@ -473,7 +483,10 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
           count,
           [&](std::size_t first, std::size_t last, int) {
             for (std::size_t l = first; l < last; ++l) {
-              lines.taut[l] = needsFullStep(lines, stretch, l, s.mass.data(), scratch.fullStepRatio) ? 1 : 0;
+              lines.taut[l] =
+                  needsFullStep(lines, stretch, cloth.stretchTension.data(), l, s.mass.data(), scratch.fullStepRatio)
+                      ? 1
+                      : 0;
             }
           },
           grain);
@@ -506,12 +519,14 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
             if (stiff) {
               const auto solveStiff = [&]<std::size_t W>(std::integral_constant<std::size_t, W>) {
                 inLanes<W>(lines, stretch, line, last - first, xpbd,
-                           [&](std::size_t G, const auto& p, const auto& lambda, const auto& offset, std::size_t n,
+                           [&](std::size_t G, const auto& p, const auto& lambda, const auto& firstLink, std::size_t n,
                                const std::uint32_t* ids) {
                              // The tension is read and summed in the same array: a line's gather
                              // reads its links' before its scatter adds to them.
                              std::array<float*, W> tension{};
-                             for (std::size_t g = 0; g < G; ++g) tension[g] = lines.tension.data() + offset[g];
+                             for (std::size_t g = 0; g < G; ++g) {
+                               tension[g] = cloth.stretchTension.data() + firstLink[g];
+                             }
                              StiffRow* rows = scratch.lineStiff.data() + slice / 4;
                              if (G == W) {
                                bool consecutive = true;
@@ -536,10 +551,10 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
               inGroups<4>(
                   lines, stretch, line, last - first, xpbd,
                   [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
-                                     const auto& offset, std::size_t n) {
+                                     const auto& firstLink, std::size_t n) {
                     std::array<float*, G> summed{};
                     for (std::size_t g = 0; geometricStiffness && scratch.sumTension && g < G; ++g) {
-                      summed[g] = lines.tension.data() + offset[g];
+                      summed[g] = cloth.stretchTension.data() + firstLink[g];
                     }
                     Vec3* normal = scratch.lineNormal.data() + slice;
                     Real* upper = scratch.lineUpper.data() + slice;

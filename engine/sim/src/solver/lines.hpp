@@ -13,9 +13,9 @@
 #include <functional>
 
 #include "drape/sim/world.hpp"
+#include "parallel/workers.hpp"
 #include "part_clock.hpp"
 #include "solver/solver_scratch.hpp"
-#include "parallel/workers.hpp"
 
 namespace drape::sim::lines {
 
@@ -30,14 +30,15 @@ bool cpuHasAvx();
 // their particles); then it is loose. The lines read their particles and rest lengths from the
 // constraints, which this puts in line order: the rows' links line by line, then the columns',
 // then the loose ones; each line's link k from its particle k (a) to k + 1 (b). A torn cloth's
-// recipe names (topology.source) move with them.
+// recipe names (topology.source) and the links' tension (Cloth::stretchTension, where it has one a
+// link) move with them.
 void build(Cloth& cloth, SolverScratch& scratch, int threads);
 
 // One Newton step of every line's projection from where its particles are now: the rows, then the
 // columns. `stiffness` scales each correction (position model); with `xpbd`, alphaTilde =
 // compliance / h^2 enters the system and the lines' lambdas accumulate. With `geometricStiffness`
-// the step adds its multipliers to the tension (scratch.lines[f].tension; the substep's first step
-// starts it from them), and with `full` too it is the full Newton step, the links' geometric
+// the step adds its multipliers to the tension (Cloth::stretchTension, while scratch.sumTension;
+// the substep's first step starts it from them), and with `full` too it is the full Newton step, the links' geometric
 // stiffness from that tension as the step found it included (at the substep's first step, the
 // last substep's); else the tridiagonal (Gauss-Newton) one. The lines of a family are
 // independent: they are shared among the workers.
@@ -66,8 +67,8 @@ int solve(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
           Workers& workers, Real* looseLambda, const Extra& extra = {},
           const std::function<void()>& afterStep = nullptr, PartClock* parts = nullptr);
 
-// At the start of a substep with geometric stiffness: the tension the last substep's steps added
-// up is what the first step uses, and that step starts the sum again.
+// At the start of a substep with geometric stiffness: the tension the last substep's first sweep
+// added up is what the first step uses, and that step starts the sum again.
 void beginSubstep(SolverScratch& scratch);
 
 }  // namespace drape::sim::lines

@@ -92,12 +92,10 @@ struct SolverScratch {
     // Line l's first link in the cloth's stretch constraints.
     std::size_t firstLink(std::size_t l) const { return linkBase + start[l] - l; }
     std::vector<Real> lambda;  // XPBD: multiplier of link k, reset each substep
-    // With geometric stiffness (solver.maxStretch): the sum of link k's multipliers (its tension
-    // times h^2, negative when pulled) over this substep's first sweep so far, or before its first
-    // step, over the last substep's first sweep.
-    // The first step reads it and starts it again (fresh). Single precision: it only scales the
-    // geometric stiffness, and chooses which lines take the full step.
-    std::vector<float> tension;
+    // With geometric stiffness (solver.maxStretch) the links' tension is the cloth's
+    // (Cloth::stretchTension): the sum of a link's multipliers over this substep's first sweep so
+    // far, or before its first step, over the last substep's first sweep. The first step reads it
+    // and starts it again (fresh).
     bool fresh = true;
     // Per line: 1 if it takes the full Newton step this substep; the lines in the order they are
     // solved (the taut ones first, tautCount of them). Worked out at the substep's first full step:

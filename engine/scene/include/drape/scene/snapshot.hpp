@@ -1,6 +1,7 @@
 // Snapshots: a session saved to a file and loaded back. The scene (its JSON document) and every
 // cloth as it is now, torn mesh and all: rest positions, triangles, constraints, positions, previous
-// positions, velocities (force model), masses and pins. Loading one is as strict as loading a
+// positions, velocities (force model), masses, pins and, where the line solve keeps it (a stretch
+// target), the links' tension, so that a loaded world goes on bit for bit. Loading one is as strict as loading a
 // scene: anything malformed is an InputError naming the file and the key.
 #pragma once
 

@@ -34,6 +34,14 @@ struct Cloth {
   // pins), less those taken out since. A particle pinned by hand gets none: it may have been put
   // anywhere, where its rest distances cannot all hold.
   std::vector<ParticleIndex> tetherPins;
+  // With a stretch target (solver.maxStretch): each stretch constraint's tension times h^2 (N s^2,
+  // negative when pulled) as the line solve last summed it, over a substep's first sweep, which
+  // the next substep's geometric stiffness reads. It is state carried from step to step, like the
+  // previous positions: a copy (undo, a snapshot) goes on bit for bit with it. Kept in the order of
+  // the stretch constraints (moved with them when the lines order them); empty where the solve
+  // keeps none, and emptied where the cloth is torn or cut. Single precision: it only scales the
+  // geometric stiffness.
+  std::vector<float> stretchTension;
 };
 
 // A finger holding particles (the seed's sticky finger). Each held particle keeps its offset from
