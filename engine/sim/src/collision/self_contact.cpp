@@ -97,6 +97,9 @@ constexpr std::size_t kLeafTriangles = 2;
 constexpr std::size_t kWalkTasks = 64;
 // Pairs of leaves a thread takes at a time when it lists their primitives' pairs.
 constexpr std::size_t kLeafPairBlock = 256;
+// A refresh's primitives a block (the strays' vertices, triangles and edges, each walked down the
+// tree): a few hundred pairs each.
+constexpr std::size_t kRefreshBlock = 64;
 
 // Closest point of triangle abc to p, as barycentric weights of a, b, c (by the triangle's Voronoi
 // regions: a corner, an edge, or the inside).
@@ -224,7 +227,8 @@ std::size_t SelfContact::bytes() const {
                       b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
                       b(reach_) + b(runNear_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) +
                       b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) +
-                      b(which0_) + b(whichX_) + b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_);
+                      b(which0_) + b(whichX_) + b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_) +
+                      b(refreshed_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(walkTests_) + b(boxTests_);
   for (const std::vector<std::uint64_t>& walked : walked_) total += b(walked);
@@ -716,7 +720,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   stats_.boxTests += tests;
 }
 
-void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
+void SelfContact::refresh(const std::vector<std::uint32_t>& strays, Workers& workers) {
   // Each stray particle's box: its motion in this substep as it now is, grown as a search grows
   // it. The triangles and edges it is a corner of are boxed again; every pair of these primitives
   // goes, and each is paired anew with whatever its box overlaps, as a search would pair it. The
@@ -744,69 +748,95 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays) {
   });
   fitTree();
 
+  // The primitives to pair again, in the order a search lists their pairs: the stray vertices, the
+  // triangles with a stray corner, the edges with a stray end. Shared among the workers in blocks,
+  // each block's pairs in its own list, joined in the blocks' order: the same pairs in the same
+  // order whatever the number of threads.
+  refreshed_.clear();
+  for (std::size_t k = 0; k < n + nt + ne; ++k) {
+    if (affected_[k]) refreshed_.push_back(static_cast<std::uint32_t>(k));
+  }
+  const std::size_t blocks = (refreshed_.size() + kRefreshBlock - 1) / kRefreshBlock;
+  found_.resize(blocks);
+  boxTests_.assign(static_cast<std::size_t>(workers.threads()), 0);
+  workers.runShared(
+      refreshed_.size(), kRefreshBlock,
+      [&](std::size_t begin, std::size_t end, int thread) {
+        std::vector<Pair> found;
+        found.swap(found_[begin / kRefreshBlock]);
+        found.clear();
+        std::int64_t compared = 0;
+        std::vector<std::uint32_t> walk;
+        // The leaves whose boxes overlap box k, in the tree's order.
+        const auto leaves = [&](std::size_t k, auto&& visit) {
+          walk.clear();
+          if (!nodes_.empty()) walk.push_back(0);
+          while (!walk.empty()) {
+            const Node& node = nodes_[walk.back()];
+            walk.pop_back();
+            ++compared;
+            if (!overlap(node.lower, node.upper, boxLower_[k], boxUpper_[k])) continue;
+            if (node.right == kNone) {
+              visit(node.left);
+            } else {
+              walk.push_back(node.right);
+              walk.push_back(node.left);
+            }
+          }
+        };
+        // Listed as a search lists them, far (measured by the fail-safe if it must be), and marked new.
+        const auto vertexTriangle = [&](std::uint32_t v, std::uint32_t t) {
+          ++compared;
+          if (!overlap(boxLower_[v], boxUpper_[v], boxLower_[n + t], boxUpper_[n + t])) return;
+          const glm::uvec3 c = triangles_[t];
+          if (c[0] == v || c[1] == v || c[2] == v) return;
+          const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
+          if (apartBoxes(corners, 1)) return;
+          found.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
+        };
+        // A stray vertex against every triangle; a triangle with a stray corner against every vertex
+        // but the stray ones (paired from their side); an edge with a stray end against every edge,
+        // and against another such edge once.
+        for (std::size_t i = begin; i < end; ++i) {
+          const std::uint32_t k = refreshed_[i];
+          if (k < n) {
+            leaves(k, [&](std::uint32_t leaf) {
+              for (std::uint32_t j = leafTriangleStart_[leaf]; j < leafTriangleStart_[leaf + 1]; ++j)
+                vertexTriangle(k, leafTriangles_[j]);
+            });
+          } else if (k < n + nt) {
+            const auto t = static_cast<std::uint32_t>(k - n);
+            leaves(k, [&](std::uint32_t leaf) {
+              for (std::uint32_t j = leafVertexStart_[leaf]; j < leafVertexStart_[leaf + 1]; ++j) {
+                if (!affected_[leafVertices_[j]]) vertexTriangle(leafVertices_[j], t);
+              }
+            });
+          } else {
+            const auto e = static_cast<std::uint32_t>(k - n - nt);
+            const glm::vec3 lo = boxLower_[k], hi = boxUpper_[k];
+            leaves(k, [&](std::uint32_t leaf) {
+              for (std::uint32_t j = leafEdgeStart_[leaf]; j < leafEdgeStart_[leaf + 1]; ++j) {
+                const std::uint32_t f = leafEdges_[j];
+                if (f == e || (affected_[n + nt + f] && f < e)) continue;
+                ++compared;
+                if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
+                const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
+                if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
+                const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
+                if (apartBoxes(corners, 2)) continue;
+                found.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
+              }
+            });
+          }
+        }
+        found_[begin / kRefreshBlock].swap(found);
+        boxTests_[static_cast<std::size_t>(thread)] += compared;
+      },
+      1);
+  for (std::size_t b = 0; b < blocks; ++b) pairs_.insert(pairs_.end(), found_[b].begin(), found_[b].end());
+  for (std::vector<Pair>& found : found_) std::vector<Pair>().swap(found);
   std::int64_t compared = 0;
-  // The leaves whose boxes overlap box k, in the tree's order.
-  const auto leaves = [&](std::size_t k, auto&& visit) {
-    walk_.clear();
-    if (!nodes_.empty()) walk_.push_back(0);
-    while (!walk_.empty()) {
-      const Node& node = nodes_[walk_.back()];
-      walk_.pop_back();
-      ++compared;
-      if (!overlap(node.lower, node.upper, boxLower_[k], boxUpper_[k])) continue;
-      if (node.right == kNone) {
-        visit(node.left);
-      } else {
-        walk_.push_back(node.right);
-        walk_.push_back(node.left);
-      }
-    }
-  };
-  // Listed as a search lists them, far (measured by the fail-safe if it must be), and marked new.
-  const auto vertexTriangle = [&](std::uint32_t v, std::uint32_t t) {
-    ++compared;
-    if (!overlap(boxLower_[v], boxUpper_[v], boxLower_[n + t], boxUpper_[n + t])) return;
-    const glm::uvec3 c = triangles_[t];
-    if (c[0] == v || c[1] == v || c[2] == v) return;
-    const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
-    if (apartBoxes(corners, 1)) return;
-    pairs_.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
-  };
-  // A stray vertex against every triangle; a triangle with a stray corner against every vertex
-  // but the stray ones (paired from their side); an edge with a stray end against every edge, and
-  // against another such edge once.
-  for (std::uint32_t v = 0; v < n; ++v) {
-    if (!affected_[v]) continue;
-    leaves(v, [&](std::uint32_t leaf) {
-      for (std::uint32_t j = leafTriangleStart_[leaf]; j < leafTriangleStart_[leaf + 1]; ++j)
-        vertexTriangle(v, leafTriangles_[j]);
-    });
-  }
-  for (std::uint32_t t = 0; t < nt; ++t) {
-    if (!affected_[n + t]) continue;
-    leaves(n + t, [&](std::uint32_t leaf) {
-      for (std::uint32_t j = leafVertexStart_[leaf]; j < leafVertexStart_[leaf + 1]; ++j) {
-        if (!affected_[leafVertices_[j]]) vertexTriangle(leafVertices_[j], t);
-      }
-    });
-  }
-  for (std::uint32_t e = 0; e < ne; ++e) {
-    if (!affected_[n + nt + e]) continue;
-    const glm::vec3 lo = boxLower_[n + nt + e], hi = boxUpper_[n + nt + e];
-    leaves(n + nt + e, [&](std::uint32_t leaf) {
-      for (std::uint32_t j = leafEdgeStart_[leaf]; j < leafEdgeStart_[leaf + 1]; ++j) {
-        const std::uint32_t f = leafEdges_[j];
-        if (f == e || (affected_[n + nt + f] && f < e)) continue;
-        ++compared;
-        if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
-        const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
-        if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
-        const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
-        if (apartBoxes(corners, 2)) continue;
-        pairs_.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
-      }
-    });
-  }
+  for (const std::int64_t tests : boxTests_) compared += tests;
   stats_.boxTests += compared;
 }
 
@@ -835,7 +865,7 @@ bool SelfContact::keepPairs(const std::vector<std::uint32_t>* candidates, Real d
     findPairs(distance, 1.0, workers);
     measurePairs(distance, workers);
   } else {
-    refresh(strays_);
+    refresh(strays_, workers);
   }
   return true;
 }
@@ -1547,7 +1577,7 @@ void SelfContact::findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<Solv
   // fold's a fifth less and the tear's a third: docs/self-contact.md.)
   if (!fresh && distance_ == settings.distance) {
     const bool few = strays(nullptr, 0.5 * settings.distance).size() * kStraysForSearch <= x_.size();
-    if (!strays_.empty() && few) refresh(strays_);
+    if (!strays_.empty() && few) refresh(strays_, workers);
     if (few) {
       reused_ = true;
       return;

@@ -178,7 +178,7 @@ class SelfContact {
   // left its box: by a refresh of the few that did (their primitives paired again by their boxes,
   // the particles' boxes now their motion), or a search where many did; whether either was needed.
   bool keepPairs(const std::vector<std::uint32_t>* candidates, Real distance, Workers& workers);
-  void refresh(const std::vector<std::uint32_t>& strays);
+  void refresh(const std::vector<std::uint32_t>& strays, Workers& workers);
   // A triangle's or edge's box from its corners' (k: its index among the boxes), or none where it
   // is torn; whether it is; whether two primitives' boxes lie apart along the line between their centres (findPairs).
   void boxPrimitive(std::size_t k);
@@ -215,6 +215,7 @@ class SelfContact {
   // boxes, and the tree's walk.
   std::vector<std::uint8_t> affected_;
   std::vector<std::uint32_t> strays_, walk_;
+  std::vector<std::uint32_t> refreshed_;  // a refresh's primitives, in their order (refresh)
   // The broad phase's tree (a bounding-volume hierarchy), built with the mesh from the rest shape:
   // cloth by cloth, then halving the triangles at the median along the longest side of their rest
   // centroids, down to leaves of at most kLeafTriangles items (triangles, and particles in no
