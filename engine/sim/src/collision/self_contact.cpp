@@ -225,10 +225,10 @@ std::size_t SelfContact::bytes() const {
   std::size_t total = b(clothOf_) + b(rest_) + b(clothSize_) + b(triangles_) + b(edges_) + b(edgeTriangles_) +
                       b(vertexStart_) + b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) +
                       b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
-                      b(reach_) + b(runNear_) + b(triangleMoved_) + b(zone_) + b(inZone_) + b(heavy_) + b(stays_) +
-                      b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) + b(slot0_) + b(slotX_) +
-                      b(which0_) + b(whichX_) + b(made0_) + b(madeX_) + b(affected_) + b(strays_) + b(walk_) +
-                      b(refreshed_);
+                      b(reach_) + b(primitiveReach_) + b(runNear_) + b(triangleMoved_) + b(zone_) + b(inZone_) +
+                      b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) +
+                      b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_) + b(affected_) +
+                      b(strays_) + b(walk_) + b(refreshed_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(walkTests_) + b(boxTests_);
   for (const std::vector<std::uint64_t>& walked : walked_) total += b(walked);
@@ -873,11 +873,28 @@ bool SelfContact::keepPairs(const std::vector<std::uint32_t>* candidates, Real d
 Real SelfContact::proven(const Pair& p) const {
   // Along a fixed line, each corner's position moves by no more than the corner does: each side's
   // reach along it grows by its farthest-gone corner's reach_, and the gap shrinks by the two.
-  const std::array<std::uint32_t, 4> v = corners(p);
-  const int split = p.edges ? 2 : 1;
-  Real most[2] = {0.0, 0.0};
-  for (int k = 0; k < 4; ++k) most[k < split ? 0 : 1] = std::max(most[k < split ? 0 : 1], reach_[v[k]]);
-  return static_cast<Real>(p.apart) - most[0] - most[1];
+  const std::size_t nt = triangles_.size();
+  const Real first = p.edges ? primitiveReach_[nt + p.first] : reach_[p.first];
+  return static_cast<Real>(p.apart) - first - primitiveReach_[(p.edges ? nt : 0) + p.second];
+}
+
+void SelfContact::reachOfPrimitives(Workers& workers) {
+  const std::size_t nt = triangles_.size(), ne = edges_.size();
+  primitiveReach_.resize(nt + ne);
+  workers.run(
+      nt + ne,
+      [&](std::size_t begin, std::size_t end, int) {
+        for (std::size_t k = begin; k < end; ++k) {
+          Real most = 0.0;
+          if (k < nt) {
+            for (int c = 0; c < 3; ++c) most = std::max(most, reach_[triangles_[k][c]]);
+          } else {
+            for (int c = 0; c < 2; ++c) most = std::max(most, reach_[edges_[k - nt][c]]);
+          }
+          primitiveReach_[k] = most;
+        }
+      },
+      4096);
 }
 
 Real SelfContact::separationAlong(const std::array<std::uint32_t, 4>& v, int split, const Vec3& axis) const {
@@ -967,6 +984,7 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
           for (std::size_t i = begin; i < end; ++i) reachOf(static_cast<std::uint32_t>(i), true);
         },
         1024);
+    reachOfPrimitives(workers);
   }
   // Two loops cut alike (as many pairs, in as many runs): the first tells each run's far pairs from
   // the others (by what is carried, or along the line between the centres) and counts these; the
@@ -1288,6 +1306,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
         coordinates_ = std::max(coordinates_, largest(x_[i]));
       }
     }
+    reachOfPrimitives(workers);
     // The pairs, in parallel: each run's tests and the far pairs it measured in its own lists,
     // joined in the runs' order (the same whatever the number of threads).
     const auto threads = static_cast<std::size_t>(workers.threads());

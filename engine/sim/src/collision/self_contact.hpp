@@ -157,8 +157,10 @@ class SelfContact {
   // (a contact's normal) proves apart what lies side by side, where the centres' line does not.
   Real separationAlong(const std::array<std::uint32_t, 4>& corners, int split, const Vec3& axis) const;
   // How far apart the pair is proven to be still, from what was proven when the pairs were last
-  // measured and how far its corners went since (reach_).
+  // measured and how far its corners went since (reach_, through primitiveReach_).
   Real proven(const Pair& pair) const;
+  // primitiveReach_ from reach_: each triangle's and edge's farthest-gone corner.
+  void reachOfPrimitives(Workers& workers);
   // reach_ of particle i, from its motion (x0 too, or x alone) against where it was measured.
   void reachOf(std::uint32_t i, bool fromX0) {
     const Vec3 d = x_[i] - xMeasured_[i];
@@ -246,6 +248,9 @@ class SelfContact {
   std::vector<Vec3> xMeasured_;        // x as the pairs were last measured
   // Per particle: how far it has gone from xMeasured_ (now, and at x0 too where the measure asks).
   std::vector<Real> reach_;
+  // Per triangle, then per edge: the largest reach_ of its corners (what proven() takes of a side),
+  // so that a pair's proof reads two numbers, not its four corners'.
+  std::vector<Real> primitiveReach_;
   // The largest coordinate of any particle at x0 or now, as measurePairs began (the rounding room of
   // separation grows with it).
   Real coordinates_ = 0.0;
