@@ -505,6 +505,22 @@ bool SelfContact::apartBoxes(const std::uint32_t* corners, int split) const {
   return hi[0] + margin < lo[1] || hi[1] + margin < lo[0];
 }
 
+void SelfContact::listVertexTriangle(std::uint32_t v, std::uint32_t t, std::vector<Pair>& out) const {
+  const glm::uvec3 c = triangles_[t];
+  if (c[0] == v || c[1] == v || c[2] == v) return;
+  const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
+  if (apartBoxes(corners, 1)) return;
+  out.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
+}
+
+void SelfContact::listEdgeEdge(std::uint32_t e, std::uint32_t f, std::vector<Pair>& out) const {
+  const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
+  if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return;
+  const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
+  if (apartBoxes(corners, 2)) return;
+  out.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
+}
+
 void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   const std::size_t n = x_.size(), nt = triangles_.size(), ne = edges_.size();
   // Boxes: each particle's motion, from x0 on for `ahead` times its motion in this substep (the
@@ -672,12 +688,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
             for (std::uint32_t j = leafTriangleStart_[to]; j < leafTriangleStart_[to + 1]; ++j) {
               const std::uint32_t t = leafTriangles_[j];
               ++compared;
-              if (!overlap(lo, hi, boxLower_[n + t], boxUpper_[n + t])) continue;
-              const glm::uvec3 c = triangles_[t];
-              if (c[0] == v || c[1] == v || c[2] == v) continue;
-              const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
-              if (apartBoxes(corners, 1)) continue;
-              vertexTriangle.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
+              if (overlap(lo, hi, boxLower_[n + t], boxUpper_[n + t])) listVertexTriangle(v, t, vertexTriangle);
             }
           }
         };
@@ -695,12 +706,7 @@ void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
             for (std::uint32_t i1 = l == m ? i0 + 1 : leafEdgeStart_[m]; i1 < leafEdgeStart_[m + 1]; ++i1) {
               const std::uint32_t f = leafEdges_[i1];
               ++compared;
-              if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
-              const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
-              if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
-              const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
-              if (apartBoxes(corners, 2)) continue;
-              edgeEdge.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
+              if (overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) listEdgeEdge(e, f, edgeEdge);
             }
           }
         }
@@ -787,12 +793,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays, Workers& wor
         // Listed as a search lists them, far (measured by the fail-safe if it must be), and marked new.
         const auto vertexTriangle = [&](std::uint32_t v, std::uint32_t t) {
           ++compared;
-          if (!overlap(boxLower_[v], boxUpper_[v], boxLower_[n + t], boxUpper_[n + t])) return;
-          const glm::uvec3 c = triangles_[t];
-          if (c[0] == v || c[1] == v || c[2] == v) return;
-          const std::uint32_t corners[4] = {v, c[0], c[1], c[2]};
-          if (apartBoxes(corners, 1)) return;
-          found.push_back({v, t, kFar, kUnproven, false, kRestUnknown});
+          if (overlap(boxLower_[v], boxUpper_[v], boxLower_[n + t], boxUpper_[n + t])) listVertexTriangle(v, t, found);
         };
         // A stray vertex against every triangle; a triangle with a stray corner against every vertex
         // but the stray ones (paired from their side); an edge with a stray end against every edge,
@@ -819,12 +820,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays, Workers& wor
                 const std::uint32_t f = leafEdges_[j];
                 if (f == e || (affected_[n + nt + f] && f < e)) continue;
                 ++compared;
-                if (!overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) continue;
-                const glm::uvec2 a = edges_[std::min(e, f)], b = edges_[std::max(e, f)];
-                if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
-                const std::uint32_t corners[4] = {a[0], a[1], b[0], b[1]};
-                if (apartBoxes(corners, 2)) continue;
-                found.push_back({std::min(e, f), std::max(e, f), kFar, kUnproven, true, kRestUnknown});
+                if (overlap(lo, hi, boxLower_[n + nt + f], boxUpper_[n + nt + f])) listEdgeEdge(e, f, found);
               }
             });
           }

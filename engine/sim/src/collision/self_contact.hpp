@@ -186,6 +186,11 @@ class SelfContact {
   void boxPrimitive(std::size_t k);
   bool torn(const std::uint32_t* corners, int count) const;
   bool apartBoxes(const std::uint32_t* corners, int split) const;
+  // Whose boxes overlap, listed as a search and a refresh list them (far, unproven, new): vertex v
+  // and triangle t unless v is a corner of t; edges e and f unless they share an end; either unless
+  // apartBoxes proves them apart.
+  void listVertexTriangle(std::uint32_t v, std::uint32_t t, std::vector<Pair>& out) const;
+  void listEdgeEdge(std::uint32_t e, std::uint32_t f, std::vector<Pair>& out) const;
 
   std::uint64_t meshVersion_ = 0;
   std::size_t meshParticles_ = 0;

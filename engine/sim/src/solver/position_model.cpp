@@ -371,7 +371,8 @@ struct StretchPlan {
 
 StretchPlan stretchPlan(const Cloth& cloth, const SolverSettings& solver, const SolverScratch& scratch) {
   StretchPlan plan;
-  if (!solver.lines() || !(solver.maxStretch > 0.0) || solver.xpbd || cloth.settings.fabric) return plan;
+  // (A target with xpbd never gets here: sim::conflict refuses it.)
+  if (!solver.lines() || !(solver.maxStretch > 0.0) || cloth.settings.fabric) return plan;
   plan.geometricStiffness = true;
   plan.tethersBetweenSteps = !scratch.tethers.empty();
   plan.extra = {plan.tethersBetweenSteps, kExtraLineSteps, solver.maxStretch};
