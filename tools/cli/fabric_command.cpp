@@ -178,23 +178,24 @@ int fabric(const FabricArguments& arguments) {
         }
       }
     }
-    report << "\n"
-           << within << " of " << runs << " runs are within 5 %.\n\n"
-           << "## Reading it\n\n"
-           << "- **Bending is solved at once.** Each sweep projects all of a cloth's bend stencils together,\n"
-           << "  one banded Cholesky solve of their XPBD block (engine/sim/src/solver/bending.hpp), so a moment reaches\n"
-           << "  the whole strip in one sweep. Swept one stencil after another instead, as before, a 3.125 mm\n"
-           << "  strip at 10 x 16 with lines sat 6 to 41 % soft, and warm-starting the stencils' multipliers\n"
-           << "  from the last substep (tried) kept fine strips oscillating at 2 sweeps.\n"
-           << "- **What is left at few sweeps is the stretch.** With the seed's Gauss-Seidel sweep over the\n"
-           << "  links, a fine strip's links stay a few per cent long (the worst strain column) and the longer\n"
-           << "  strip droops more; solved a line at a time they hold, and at 16 sweeps every preset is\n"
-           << "  within 3 % at every spacing. At 2 sweeps the bending and the lines have not yet agreed on a\n"
-           << "  3.125 mm strip (4 to 12 % soft).\n"
-           << "- **Converged runs are within a per cent.** The stencils are the lattice's Laplacian along its\n"
-           << "  stretch lines, the same whichever way the sheet is rolled (tests/sim/fabric_test.cpp,\n"
-           << "  `BendStencils.*`). An earlier model, a hinge per edge, bent 0.79 to 2.9 times as hard off the\n"
-           << "  lattice's axes, and a strip twisted towards the soft way and sat 2 to 5 % soft.\n";
+    report
+        << "\n"
+        << within << " of " << runs << " runs are within 5 %.\n\n"
+        << "## Reading it\n\n"
+        << "- **Bending is solved at once.** Each sweep projects all of a cloth's bend stencils together,\n"
+        << "  one banded Cholesky solve of their XPBD block (engine/sim/src/solver/bending.hpp), so a moment reaches\n"
+        << "  the whole strip in one sweep. Swept one stencil after another instead, as before, a 3.125 mm\n"
+        << "  strip at 10 x 16 with lines sat 6 to 41 % soft, and warm-starting the stencils' multipliers\n"
+        << "  from the last substep (tried) kept fine strips oscillating at 2 sweeps.\n"
+        << "- **What is left at few sweeps is the stretch.** With the seed's Gauss-Seidel sweep over the\n"
+        << "  links, a fine strip's links stay a few per cent long (the worst strain column) and the longer\n"
+        << "  strip droops more; solved a line at a time they hold, and at 16 sweeps every preset is\n"
+        << "  within 3 % at every spacing. At 2 sweeps the bending and the lines have not yet agreed on a\n"
+        << "  3.125 mm strip (4 to 12 % soft).\n"
+        << "- **Converged runs are within a per cent.** The stencils are the lattice's Laplacian along its\n"
+        << "  stretch lines, the same whichever way the sheet is rolled (tests/sim/fabric_test.cpp,\n"
+        << "  `BendStencils.*`). An earlier model, a hinge per edge, bent 0.79 to 2.9 times as hard off the\n"
+        << "  lattice's axes, and a strip twisted towards the soft way and sat 2 to 5 % soft.\n";
 
     const std::vector<DrapeRun> drapes = drapeRuns();
     std::ostringstream drapeCsv;
