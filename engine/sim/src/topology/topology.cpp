@@ -1439,6 +1439,11 @@ bool breakAt(Cloth& cloth, ParticleIndex v, Vec3 pull, const Incidence& incidenc
 
 // A few sweeps over the stretch and shear links within kRelaxRings of the particles `from`, so the
 // flanks of a fresh crack let go of their tension before the next pass decides where it runs on.
+// The sweeps turn no triangle over: self-contact never tests two triangles that share a corner, so
+// nothing else would stop a sweep folding a thin triangle by a fresh crack flat onto its neighbour
+// (a cloth lying on a table then lies through itself there until the next step undoes it). A
+// particle whose move turned one of its triangles over (its normal now against the one it had)
+// goes back to where the sweeps found it, until none is turned.
 void relax(Cloth& cloth, const std::vector<ParticleIndex>& from) {
   ClothRest& rest = cloth.rest;
   ParticleState& s = cloth.state;
@@ -1461,6 +1466,34 @@ void relax(Cloth& cloth, const std::vector<ParticleIndex>& from) {
     }
     ring = std::move(next);
   }
+  // The particles the sweeps may move (both ends of a link with an end inside), and where each is
+  // in that list (kNone: not in it).
+  constexpr std::uint32_t kNone = UINT32_MAX;
+  std::vector<std::uint32_t> slot(rest.particleCount(), kNone);
+  std::vector<ParticleIndex> region;
+  for (const ConstraintKind kind : {ConstraintKind::stretch, ConstraintKind::shear}) {
+    for (const DistanceConstraint& c : rest.of(kind)) {
+      if (!inside[c.a] && !inside[c.b]) continue;
+      for (const ParticleIndex p : {c.a, c.b}) {
+        if (slot[p] != kNone) continue;
+        slot[p] = static_cast<std::uint32_t>(region.size());
+        region.push_back(p);
+      }
+    }
+  }
+  const auto normalOf = [&](const Triangle& t) {
+    return glm::cross(s.position[t[1]] - s.position[t[0]], s.position[t[2]] - s.position[t[0]]);
+  };
+  std::vector<Vec3> start(region.size());
+  for (std::size_t k = 0; k < region.size(); ++k) start[k] = s.position[region[k]];
+  std::vector<std::uint32_t> touched;  // the triangles with a corner in the region, each once
+  for (const ParticleIndex p : region) {
+    for (auto t = incidence.begin(p); t != incidence.end(p); ++t) touched.push_back(*t);
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  std::vector<Vec3> normalBefore(touched.size());
+  for (std::size_t k = 0; k < touched.size(); ++k) normalBefore[k] = normalOf(rest.triangles[touched[k]]);
   for (int sweep = 0; sweep < kRelaxSweeps; ++sweep) {
     for (const ConstraintKind kind : {ConstraintKind::stretch, ConstraintKind::shear}) {
       for (const DistanceConstraint& c : rest.of(kind)) {
@@ -1473,6 +1506,22 @@ void relax(Cloth& cloth, const std::vector<ParticleIndex>& from) {
         const Vec3 correction = (length - static_cast<Real>(c.restLength)) / (length * (wa + wb)) * d;
         s.position[c.a] += wa * correction;
         s.position[c.b] -= wb * correction;
+      }
+    }
+  }
+  // Each round puts back at least one particle (a triangle whose corners are all back is as it
+  // was, not turned), so this ends.
+  for (bool turned = true; turned;) {
+    turned = false;
+    for (std::size_t k = 0; k < touched.size(); ++k) {
+      const Vec3 before = normalBefore[k];
+      const Triangle& t = rest.triangles[touched[k]];
+      if (!(glm::dot(before, before) > 0.0) || glm::dot(normalOf(t), before) > 0.0) continue;
+      for (int corner = 0; corner < 3; ++corner) {
+        const ParticleIndex p = t[corner];
+        if (slot[p] == kNone || s.position[p] == start[slot[p]]) continue;
+        s.position[p] = start[slot[p]];
+        turned = true;
       }
     }
   }
