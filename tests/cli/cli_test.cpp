@@ -329,6 +329,32 @@ TEST_F(Cli, StudyReportsErrorAgainstTimeWithAParetoFront) {
   expectOneLineError(run("study chain --sweep solver.substeps"), 2, "--sweep solver.substeps: expected path=value1");
 }
 
+TEST_F(Cli, StudySkipsTheCombinationsWhoseKeysDoNotGoTogether) {
+  // A max stretch needs the lines (sim::conflict): of the four combinations, the seed's sweep with
+  // a target is not run, and the report says so; the other three are.
+  const fs::path folder = file("conflict"), report = file("conflict.md");
+  const Result result =
+      run("study chain --time 0.1 --repeats 1 --no-reference --sweep solver.stretchSolver=gauss-seidel,lines --sweep "
+          "solver.maxStretch=0,0.04 --quiet --out-dir '" +
+          folder.string() + "' --report '" + report.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  std::istringstream csv(read(folder / "accuracy.csv"));
+  std::string line;
+  std::getline(csv, line);
+  std::vector<std::string> labels;
+  while (std::getline(csv, line)) labels.push_back(line.substr(0, line.find(',', line.find('"', 1))));
+  EXPECT_EQ(labels, (std::vector<std::string>{"\"stretchSolver=gauss-seidel maxStretch=0\"",
+                                              "\"stretchSolver=lines maxStretch=0\"",
+                                              "\"stretchSolver=lines maxStretch=0.04\""}));
+  const std::string text = read(report);
+  EXPECT_NE(text.find("Not run, their keys do not go together"), std::string::npos);
+  EXPECT_NE(text.find("stretchSolver=gauss-seidel maxStretch=0.04."), std::string::npos);
+  // Every combination refused: nothing to report, and a one-line error.
+  expectOneLineError(
+      run("study chain --set solver.stretchSolver=gauss-seidel --sweep solver.maxStretch=0.02,0.04 --no-reference"), 2,
+      "maxStretch");
+}
+
 TEST_F(Cli, StudyChoosesTheCheapestRunWithinTheStrainBound) {
   // On the chain one substep of two sweeps stretches it by far more than 5 % on its way
   // down, eight substeps do not.

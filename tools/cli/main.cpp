@@ -133,7 +133,9 @@ int main(int argc, char** argv) {
       app.add_subcommand("study", "Error against run time over configurations of a scene, and integrator orders");
   addSceneOptions(studyCommand, studyArguments.input);
   addLengthOptions(studyCommand, studyArguments.steps, studyArguments.seconds);
-  studyCommand->add_option("--sweep", studyArguments.sweeps, "path=v1,v2,... (repeatable: every combination runs)");
+  studyCommand->add_option(
+      "--sweep", studyArguments.sweeps,
+      "path=v1,v2,... (repeatable: every combination runs, but those whose keys do not go together)");
   studyCommand->add_option("--repeats", studyArguments.repeats, "Timed runs per configuration (median)")
       ->transform(kDecimal)
       ->check(CLI::Range(1, 100));

@@ -1,6 +1,6 @@
 // drape-cli study: error against run time. Sweeps configurations of a scene (every combination of
-// the --sweep values), and for each reports CPU time per simulated second (median of repeats), the
-// constraint error (structural strain over the run) and the trajectory error (RMS distance from a
+// the --sweep values whose keys go together: sim::conflict), and for each reports CPU time per simulated second (median
+// of repeats), the constraint error (structural strain over the run) and the trajectory error (RMS distance from a
 // reference run of the same scene at 8x the substeps and 4x the iterations); marks the Pareto front
 // in a log-log gnuplot picture; and adds each integrator's observed convergence order on the
 // harmonic oscillator against its exact solution.
@@ -10,7 +10,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -142,8 +145,12 @@ int study(const StudyArguments& arguments) {
       bool pareto = false;
     };
     std::vector<Row> rows;
+    // Combinations whose keys do not go together (sim::conflict: a max stretch with the seed's
+    // sweep, say), not run: their labels and the first one's reason.
+    std::vector<std::string> skipped;
+    std::string skippedWhy;
     std::vector<std::size_t> index(sweeps.size(), 0);
-    while (true) {
+    for (bool more = true; more;) {
       std::vector<std::string> overrides = arguments.input.overrides;
       std::string label;
       for (std::size_t s = 0; s < sweeps.size(); ++s) {
@@ -151,7 +158,20 @@ int study(const StudyArguments& arguments) {
         label += (label.empty() ? "" : " ") + sweeps[s].key.substr(sweeps[s].key.rfind('.') + 1) + "=" +
                  sweeps[s].values[index[s]];
       }
-      const scene::Scene configured = scene::loadScene(scene::resolveScenePath(arguments.input.scene), overrides);
+      std::size_t next = 0;
+      while (next < sweeps.size() && ++index[next] == sweeps[next].values.size()) index[next++] = 0;
+      more = next < sweeps.size();
+      std::optional<scene::Scene> loaded;
+      try {
+        loaded = scene::loadScene(scene::resolveScenePath(arguments.input.scene), overrides);
+      } catch (const scene::KeyConflict& conflict) {
+        // Only a combination the sweep made: the scene as given must load.
+        if (sweeps.empty()) throw;
+        if (skipped.empty()) skippedWhy = conflict.what();
+        skipped.push_back(label);
+        continue;
+      }
+      const scene::Scene& configured = *loaded;
       std::vector<double> times;
       Trajectory run;
       for (int r = 0; r < arguments.repeats; ++r) {
@@ -162,10 +182,9 @@ int study(const StudyArguments& arguments) {
       rows.push_back({label.empty() ? "scene as written" : label, run.diverged ? NAN : bench::median(times),
                       run.diverged ? NAN : run.strainMax, run.diverged ? NAN : run.strainMean,
                       run.diverged || arguments.noReference ? NAN : rmsDistance(run, reference), run.diverged});
-      std::size_t s = 0;
-      while (s < sweeps.size() && ++index[s] == sweeps[s].values.size()) index[s++] = 0;
-      if (s == sweeps.size()) break;
     }
+    if (rows.empty())
+      throw scene::InputError(base.source + ": no combination of the sweeps goes together: " + skippedWhy);
     // Pareto front: no other run is both faster and more accurate.
     // Without a reference the accuracy compared is the worst strain.
     const auto inaccuracy = [&](const Row& row) { return arguments.noReference ? row.strainMax : row.error; };
@@ -256,6 +275,11 @@ int study(const StudyArguments& arguments) {
                     100.0 * r.strainMax, 100.0 * r.strainMean,
                     r.diverged ? "diverged" : (std::to_string(r.error)).c_str(), r.pareto ? "yes" : "");
       report << line;
+    }
+    if (!skipped.empty()) {
+      report << "\nNot run, their keys do not go together (`sim::conflict`; the first: " << skippedWhy << "): ";
+      for (std::size_t k = 0; k < skipped.size(); ++k) report << (k > 0 ? ", " : "") << skipped[k];
+      report << ".\n";
     }
     report << "\n## Convergence order of the force model's integrators\n\n"
            << "The harmonic oscillator against its exact solution (a 1 kg ball on a 100 N/m spring under gravity,\n"

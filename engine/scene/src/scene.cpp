@@ -273,7 +273,11 @@ Scene parseScene(const json& document, const std::string& source) {
     // Keys that do not go with the others (the engine's one rule for it: sim::conflict).
     if (const std::optional<sim::SolverConflict> c = sim::conflict(world.solver)) {
       const std::string key(c->key);
-      solver.fail(key, c->value, solver.raw(key));
+      try {
+        solver.fail(key, c->value, solver.raw(key));
+      } catch (const InputError& error) {
+        throw KeyConflict(error.what());
+      }
     }
     solver.finish();
   }

@@ -20,4 +20,11 @@ class InputError : public std::runtime_error {
   explicit InputError(const std::string& message) : std::runtime_error(printable(message, 2000)) {}
 };
 
+// Keys each valid alone that do not go together (sim::conflict: a max stretch with the seed's sweep,
+// say). A study that sweeps every combination of some keys skips these and says which.
+class KeyConflict : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 }  // namespace drape::scene
