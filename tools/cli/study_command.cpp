@@ -167,7 +167,13 @@ int study(const StudyArguments& arguments) {
       } catch (const scene::KeyConflict& conflict) {
         // Only a combination the sweep made: the scene as given must load.
         if (sweeps.empty()) throw;
-        if (skipped.empty()) skippedWhy = conflict.what();
+        if (skipped.empty()) {
+          // Named as the report names the scene (from assets/ on, not where this machine keeps it).
+          skippedWhy = conflict.what();
+          const std::size_t assets = base.source.rfind("assets/");
+          if (assets != std::string::npos && skippedWhy.rfind(base.source, 0) == 0)
+            skippedWhy = base.source.substr(assets) + skippedWhy.substr(base.source.size());
+        }
         skipped.push_back(label);
         continue;
       }

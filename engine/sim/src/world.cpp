@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -17,6 +16,7 @@
 
 #include "collision/contacts.hpp"
 #include "collision/self_contact.hpp"
+#include "invariant.hpp"
 #include "parallel/workers.hpp"
 #include "solver/batches.hpp"
 #include "solver/force_model.hpp"
@@ -535,16 +535,66 @@ void World::startHistory() {
   historyStarted_ = true;
 }
 
-void World::runStage(Stage stage, PartClock& parts) {
-  const Real h = static_cast<Real>(substepDt());
-  // Work over the whole world first: colliders move once per substep, and self-collision spans
-  // every cloth at once.
-  if (stage == Stage::collide || stage == Stage::collideForces) moveColliders();
-  if (stage == Stage::selfCollide) {
-    contact::selfCollide(cloths_, settings_.selfCollision, *selfCollisionScratch_, *workers_);
-    return;
+namespace {
+// The pipeline's entry for `stage`, or null where the pipeline has no such stage.
+StageTiming* entryOf(Profile& profile, Stage stage) {
+  for (StageTiming& timing : profile) {
+    if (timing.stage == stage) return &timing;
   }
-  if (stage == Stage::selfContact) {
+  return nullptr;
+}
+}  // namespace
+
+template <class Work>
+void World::timed(Stage stage, Work&& work) {
+  StageTiming* const timing = entryOf(profile_, stage);
+  if (!timing) return;
+  // The rows run their stages in the order the pipeline lists them, which is the order the profile
+  // and the app's stage plot show.
+  DRAPE_INVARIANT(timing - profile_.data() > rowAt_, "buildPipeline lists the stages in the order the rows run them");
+  rowAt_ = timing - profile_.data();
+  PartClock parts(*timing);
+  const auto start = std::chrono::steady_clock::now();
+  std::forward<Work>(work)(parts);
+  timing->lastSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A substep of the position model, stage by stage. Each runs where the pipeline has it
+// (buildPipeline): over every cloth, or over the world at once (fingers, self-collision and
+// self-contact span every cloth; colliders move once a substep).
+void World::positionSubstep(Real h) {
+  timed(Stage::fingers, [&](PartClock&) { moveFingers(h); });
+  timed(Stage::windPressure, [&](PartClock&) {
+    for (std::size_t c = 0; c < cloths_.size(); ++c)
+      position::accumulateWindPressure(cloths_[c], settings_.air, h, scratch_[c].acceleration);
+  });
+  timed(Stage::verletIntegrate, [&](PartClock&) {
+    const bool keep = guardCopy_ == GuardCopy::integration && substep_ == 0;
+    for (std::size_t c = 0; c < cloths_.size(); ++c) {
+      std::vector<Vec3>& acceleration = scratch_[c].acceleration;
+      position::integrate(cloths_[c], settings_, h, acceleration.empty() ? nullptr : &acceleration, *workers_,
+                          keep ? lastGood_[c].data() : nullptr);
+    }
+  });
+  timed(Stage::selfCollide,
+        [&](PartClock&) { contact::selfCollide(cloths_, settings_.selfCollision, *selfCollisionScratch_, *workers_); });
+  timed(Stage::collide, [&](PartClock&) {
+    moveColliders();
+    for (std::size_t c = 0; c < cloths_.size(); ++c) contact::detect(cloths_[c], colliders_, scratch_[c]);
+  });
+  timed(Stage::projectConstraints, [&](PartClock& parts) {
+    for (std::size_t c = 0; c < cloths_.size(); ++c) {
+      // Planned when the world changed (planAll), never in a timed stage. (Should a path have missed
+      // it, a build that does not check this plans here, and the plan shows in the profile.)
+      DRAPE_INVARIANT(scratch_[c].planVersion == topologyVersion_, "planAll ran after every change a plan is made of");
+      if (scratch_[c].planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
+      position::projectConstraints(cloths_[c], settings_.solver, h, scratch_[c], colliders_, *workers_, parts);
+    }
+  });
+  timed(Stage::friction, [&](PartClock&) {
+    for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, h, scratch_[c]);
+  });
+  timed(Stage::selfContact, [&](PartClock& parts) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
     selfContact_->solve(cloths_, scratch_, settings_.selfCollision, topologyVersion_,
                         settings_.solver.substeps - substep_, *workers_, &parts);
@@ -554,59 +604,28 @@ void World::runStage(Stage stage, PartClock& parts) {
       });
     }
     selfContact_->finish(cloths_, settings_.selfCollision, *workers_, &parts);
-    return;
-  }
-  if (stage == Stage::fingers) {
-    moveFingers(h);
-    return;
-  }
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    Cloth& cloth = cloths_[c];
-    SolverScratch& scratch = scratch_[c];
-    switch (stage) {
-      case Stage::windPressure: position::accumulateWindPressure(cloth, settings_.air, h, scratch.acceleration); break;
-      case Stage::verletIntegrate: {
-        const bool keep = guardCopy_ == GuardCopy::integration && substep_ == 0;
-        position::integrate(cloth, settings_, h, scratch.acceleration.empty() ? nullptr : &scratch.acceleration,
-                            *workers_, keep ? lastGood_[c].data() : nullptr);
-        break;
-      }
-      case Stage::projectConstraints:
-        // Planned when the world changed (planAll); should a path have missed it, the plan shows here.
-        if (scratch.planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
-        position::projectConstraints(cloth, settings_.solver, h, scratch, colliders_, *workers_, parts);
-        break;
-      case Stage::dampConstraints: position::dampConstraints(cloth); break;
-      case Stage::clampTravel:
-        contact::clampTravel(cloth, settings_.selfCollision.maxTravel * settings_.selfCollision.distance);
-        break;
-      case Stage::collide: contact::detect(cloth, colliders_, scratch); break;
-      case Stage::friction: contact::friction(cloth, colliders_, h, scratch); break;
-      case Stage::collideForces: contact::respondWithVelocities(cloth, colliders_, h, scratch); break;
-      case Stage::explicitEuler:
-      case Stage::symplecticEuler:
-      case Stage::verletForces:
-      case Stage::midpoint:
-      case Stage::rk4: force::step(settings_.solver.integrator, cloth, settings_, h, scratch); break;
-      case Stage::fingers:      // world-wide, above
-      case Stage::selfCollide:  // world-wide, above
-      case Stage::selfContact:
-      case Stage::guard:  // once per step, in step()
-      case Stage::tear:
-      case Stage::plan:  // parts, run inside their stages
-      case Stage::tethers:
-      case Stage::bendStencils:
-      case Stage::bend:
-      case Stage::shear:
-      case Stage::stretch:
-      case Stage::looseLinks:
-      case Stage::contactPlanes:
-      case Stage::broadPhase:
-      case Stage::narrowPhase:
-      case Stage::contactSweep:
-      case Stage::failSafe: break;
-    }
-  }
+  });
+  timed(Stage::clampTravel, [&](PartClock&) {
+    for (Cloth& cloth : cloths_)
+      contact::clampTravel(cloth, settings_.selfCollision.maxTravel * settings_.selfCollision.distance);
+  });
+  timed(Stage::dampConstraints, [&](PartClock&) {
+    for (Cloth& cloth : cloths_) position::dampConstraints(cloth);
+  });
+}
+
+// A substep of the force model: the integrator's stage (one of five), then the colliders.
+void World::forceSubstep(Real h) {
+  timed(Stage::fingers, [&](PartClock&) { moveFingers(h); });
+  const Integrator integrator = settings_.solver.integrator;
+  timed(integratorStage(integrator), [&](PartClock&) {
+    for (std::size_t c = 0; c < cloths_.size(); ++c) force::step(integrator, cloths_[c], settings_, h, scratch_[c]);
+  });
+  timed(Stage::collideForces, [&](PartClock&) {
+    moveColliders();
+    for (std::size_t c = 0; c < cloths_.size(); ++c)
+      contact::respondWithVelocities(cloths_[c], colliders_, h, scratch_[c]);
+  });
 }
 
 void World::moveColliders() {
@@ -667,7 +686,6 @@ std::optional<Divergence> World::findBadParticle() const {
 }
 
 StepStatus World::step() {
-  using Clock = std::chrono::steady_clock;
   if (divergence_) return StepStatus::diverged;
   if (!historyStarted_) startHistory();
   // The positions before the step, for the guard (where its copy is made: buildPipeline).
@@ -693,23 +711,19 @@ StepStatus World::step() {
     timing.lastSeconds = 0.0;
     for (StageTiming& part : timing.parts) part.lastSeconds = 0.0;
   }
+  const Real h = static_cast<Real>(substepDt());
   for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
     substep_ = substep;
-    for (StageTiming& timing : profile_) {
-      if (!timing.perSubstep) continue;
-      PartClock parts(timing);
-      const auto start = Clock::now();
-      runStage(timing.stage, parts);
-      timing.lastSeconds += std::chrono::duration<double>(Clock::now() - start).count();
+    rowAt_ = -1;
+    if (settings_.solver.model == Model::position) {
+      positionSubstep(h);
+    } else {
+      forceSubstep(h);
     }
   }
-  for (StageTiming& timing : profile_) {
-    if (timing.perSubstep) continue;
-    const auto start = Clock::now();
-    if (timing.stage == Stage::guard) divergence_ = findBadParticle();
-    if (timing.stage == Stage::tear && !divergence_) tear();
-    timing.lastSeconds += std::chrono::duration<double>(Clock::now() - start).count();
-  }
+  // Once a step: the guard, then (if it found nothing) tearing.
+  timed(Stage::guard, [&](PartClock&) { divergence_ = findBadParticle(); });
+  if (!divergence_) timed(Stage::tear, [&](PartClock&) { tear(); });
   for (StageTiming& timing : profile_) {
     timing.totalSeconds += timing.lastSeconds;
     for (StageTiming& part : timing.parts) part.totalSeconds += part.lastSeconds;
@@ -731,7 +745,34 @@ StepStatus World::step() {
   }
   for (Finger& finger : fingers_) finger.position = finger.target;
   ++stepCount_;
+  if constexpr (kCheckInvariants) checkInvariants();
   return StepStatus::ok;
+}
+
+// What every step leaves as it found it: one record per cloth in each per-cloth array, each
+// particle's arrays as long as its cloth's positions, and the fingers' grips on particles that exist.
+void World::checkInvariants() const {
+  DRAPE_INVARIANT(scratch_.size() == cloths_.size() && held_.size() == cloths_.size(), "a record per cloth");
+  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    const ParticleState& s = cloths_[c].state;
+    const std::size_t n = s.position.size();
+    DRAPE_INVARIANT(n == cloths_[c].rest.particleCount(), "a particle's rest and state together");
+    DRAPE_INVARIANT(
+        s.previousPosition.size() == n && s.inverseMass.size() == n && s.mass.size() == n && s.pinned.size() == n,
+        "every particle array as long as the positions");
+    DRAPE_INVARIANT(s.velocity.empty() || s.velocity.size() == n, "velocities for every particle or none");
+    DRAPE_INVARIANT(held_[c].empty() || held_[c].size() == n, "held flags for every particle or none");
+    DRAPE_INVARIANT(scratch_[c].acceleration.empty() || scratch_[c].acceleration.size() == n,
+                    "wind accelerations for every particle or none");
+  }
+  for (const Finger& finger : fingers_) {
+    for (const FingerGrip& grip : finger.grips) {
+      const auto c = static_cast<std::size_t>(grip.cloth);
+      DRAPE_INVARIANT(c < cloths_.size() && grip.particle < cloths_[c].state.position.size(),
+                      "a finger holds particles that exist");
+      DRAPE_INVARIANT(isHeld(c, grip.particle), "a particle a finger holds is marked held");
+    }
+  }
 }
 
 StepStatus World::run(std::int64_t steps) {
@@ -1044,14 +1085,17 @@ int World::changeTopology(
       } else if (o <= -2) {
         from[p] = from[static_cast<std::size_t>(-2 - o)];
       } else {
-        assert(false && "every new particle is a split's copy or an insert");
+        DRAPE_INVARIANT(false, "every new particle is a split's copy or an insert");
         from[p] = cloths_[c].state.position[p];
       }
     }
   }
   if (settle && opened > 0) {
     // (A cloth that did not change has as many particles as before.)
-    for (std::size_t c = 0; c < cloths_.size(); ++c) assert(before[c].size() == cloths_[c].state.position.size());
+    for (std::size_t c = 0; c < cloths_.size(); ++c) {
+      DRAPE_INVARIANT(before[c].size() == cloths_[c].state.position.size(),
+                      "a cloth that did not change kept its particles");
+    }
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
     selfContact_->settle(cloths_, before, settings_.selfCollision, topologyVersion_, *workers_);
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <bit>
 
+#include "invariant.hpp"
+
 namespace drape::sim::batches {
 
 Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source, bool stretchToo) {
@@ -45,6 +47,19 @@ Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstrai
       sorted[to[k]] = constraints[k];
     }
     constraints.swap(sorted);
+    if constexpr (kCheckInvariants) {
+      // What lets a batch be shared among threads: no particle twice in it (but the tail).
+      std::vector<std::uint32_t> lastBatch(n, UINT32_MAX);
+      for (std::size_t b = 0; b + 1 < start.size(); ++b) {
+        if (result.sequentialTail[kind] && b + 2 == start.size()) break;
+        for (std::uint32_t k = start[b]; k < start[b + 1]; ++k) {
+          for (const ParticleIndex p : {constraints[k].a, constraints[k].b}) {
+            DRAPE_INVARIANT(lastBatch[p] != b, "a batch's constraints share no particle");
+            lastBatch[p] = static_cast<std::uint32_t>(b);
+          }
+        }
+      }
+    }
     if (source && (*source)[kind].size() == to.size()) {
       std::vector<std::uint32_t> moved(to.size());
       for (std::size_t k = 0; k < to.size(); ++k) moved[to[k]] = (*source)[kind][k];

@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "invariant.hpp"
 #include "solver/lines_wide.hpp"
 #include "solver/position_model.hpp"
 #include "solver/stiff_lanes.hpp"
@@ -429,6 +430,15 @@ void build(Cloth& cloth, SolverScratch& scratch, int threads) {
   stretch.swap(ordered);
   for (SolverScratch::LineFamily& lines : scratch.lines) {
     const std::size_t count = lines.start.size() - 1;
+    if constexpr (kCheckInvariants) {
+      // What the line solve reads: a line's links in order, each starting where the one before ends.
+      for (std::size_t l = 0; l < count; ++l) {
+        for (std::size_t k = 1; k + 1 < lines.start[l + 1] - lines.start[l]; ++k) {
+          DRAPE_INVARIANT(stretch[lines.firstLink(l) + k].a == stretch[lines.firstLink(l) + k - 1].b,
+                          "a line's links run end to end");
+        }
+      }
+    }
     lines.besideNext.assign(count, 0);
     for (std::size_t l = 0; l + 1 < count; ++l) {
       const std::uint32_t length = lines.start[l + 1] - lines.start[l];

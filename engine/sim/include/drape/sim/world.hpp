@@ -6,6 +6,7 @@
 // before that step, and the world refuses to step further. The caller decides what to tell whom.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -241,11 +242,19 @@ class World {
                                               std::vector<ParticleInsert>&)>& change);
   void grab(Finger& finger, std::size_t cloth, ParticleIndex nearest);
   std::size_t particleCount() const;
-  void runStage(Stage stage, PartClock& parts);
+  // The step's rows of stages (world.cpp): a substep of either model, each stage where the
+  // pipeline has it, timed into its entry.
+  void positionSubstep(Real h);
+  void forceSubstep(Real h);
+  template <class Work>
+  void timed(Stage stage, Work&& work);
   void startHistory();
   void startHistory(std::size_t cloth);
   void moveColliders();
   std::optional<Divergence> findBadParticle() const;
+  // Aborts where the world breaks what each step must leave (world.cpp; the checking build only:
+  // src/invariant.hpp).
+  void checkInvariants() const;
   Finger* findFinger(int id);
 
   WorldSettings settings_;
@@ -262,7 +271,8 @@ class World {
   // Self-contact is on: a held particle may lag its finger where the finger would drive it through
   // cloth (moveFingers).
   bool selfContactHolds_ = false;
-  int substep_ = 0;  // within the current step
+  int substep_ = 0;            // within the current step
+  std::ptrdiff_t rowAt_ = -1;  // the profile entry of the stage the row last ran (timed)
   // Where the guard finds the positions before the current step (World::step).
   enum class GuardCopy : std::uint8_t {
     none,         // in the previous positions: one substep's integration left them there untouched
