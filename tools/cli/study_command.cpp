@@ -190,7 +190,7 @@ int study(const StudyArguments& arguments) {
                       run.diverged || arguments.noReference ? NAN : rmsDistance(run, reference), run.diverged});
     }
     if (rows.empty())
-      throw scene::InputError(base.source + ": no combination of the sweeps goes together: " + skippedWhy);
+      throw scene::InputError("no combination of the sweeps has keys that go together; the first: " + skippedWhy);
     // Pareto front: no other run is both faster and more accurate.
     // Without a reference the accuracy compared is the worst strain.
     const auto inaccuracy = [&](const Row& row) { return arguments.noReference ? row.strainMax : row.error; };

@@ -553,6 +553,7 @@ void World::timed(Stage stage, Work&& work) {
   // and the app's stage plot show.
   DRAPE_INVARIANT(timing - profile_.data() > rowAt_, "buildPipeline lists the stages in the order the rows run them");
   rowAt_ = timing - profile_.data();
+  ++rowRan_;
   PartClock parts(*timing);
   const auto start = std::chrono::steady_clock::now();
   std::forward<Work>(work)(parts);
@@ -584,8 +585,9 @@ void World::positionSubstep(Real h) {
   });
   timed(Stage::projectConstraints, [&](PartClock& parts) {
     for (std::size_t c = 0; c < cloths_.size(); ++c) {
-      // Planned when the world changed (planAll), never in a timed stage. (Should a path have missed
-      // it, a build that does not check this plans here, and the plan shows in the profile.)
+      // Planned when the world changed (planAll: a tear's or a cut's time includes it), never by the
+      // sweeps' own stage. (Should a path have missed it, a build that does not check this plans
+      // here, and the plan shows in the profile.)
       DRAPE_INVARIANT(scratch_[c].planVersion == topologyVersion_, "planAll ran after every change a plan is made of");
       if (scratch_[c].planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
       position::projectConstraints(cloths_[c], settings_.solver, h, scratch_[c], colliders_, *workers_, parts);
@@ -715,11 +717,16 @@ StepStatus World::step() {
   for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
     substep_ = substep;
     rowAt_ = -1;
+    rowRan_ = 0;
     if (settings_.solver.model == Model::position) {
       positionSubstep(h);
     } else {
       forceSubstep(h);
     }
+    DRAPE_INVARIANT(
+        rowRan_ == static_cast<std::size_t>(std::count_if(profile_.begin(), profile_.end(),
+                                                          [](const StageTiming& t) { return t.perSubstep; })),
+        "a substep's row runs every stage the pipeline has for it");
   }
   // Once a step: the guard, then (if it found nothing) tearing.
   timed(Stage::guard, [&](PartClock&) { divergence_ = findBadParticle(); });

@@ -1441,9 +1441,9 @@ bool breakAt(Cloth& cloth, ParticleIndex v, Vec3 pull, const Incidence& incidenc
 // flanks of a fresh crack let go of their tension before the next pass decides where it runs on.
 // The sweeps turn no triangle over: self-contact never tests two triangles that share a corner, so
 // nothing else would stop a sweep folding a thin triangle by a fresh crack flat onto its neighbour
-// (a cloth lying on a table then lies through itself there until the next step undoes it). A
-// particle whose move turned one of its triangles over (its normal now against the one it had)
-// goes back to where the sweeps found it, until none is turned.
+// (a cloth lying on a table then lies through itself there until the next step undoes it). The
+// moved corners of a triangle the sweeps turned over (its normal now against the one it had) go
+// back to where the sweeps found them, until none is turned.
 void relax(Cloth& cloth, const std::vector<ParticleIndex>& from) {
   ClothRest& rest = cloth.rest;
   ParticleState& s = cloth.state;

@@ -229,8 +229,9 @@ class World {
   void plan(std::size_t cloth);
   // Plans every cloth, where the pipeline projects constraints: at once, whenever what a plan is
   // made of changes (the world made, a cloth added, removed, restored, torn or cut, the threads
-  // or the solver changed), so that no stage plans while it is timed. (The constraint stage still
-  // plans a cloth whose plan is out of date, as its part `plan`: no path the tests take leaves one.)
+  // or the solver changed), so that the sweeps never plan inside their own stage (a tear's or a
+  // cut's plan is timed with it). (A build that does not check invariants still plans, in the
+  // constraint stage as its part `plan`, a cloth whose plan a path left out of date.)
   void planAll();
   void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits,
                            const std::vector<ParticleInsert>& inserted = {});
@@ -273,6 +274,7 @@ class World {
   bool selfContactHolds_ = false;
   int substep_ = 0;            // within the current step
   std::ptrdiff_t rowAt_ = -1;  // the profile entry of the stage the row last ran (timed)
+  std::size_t rowRan_ = 0;     // stages the row ran in this substep
   // Where the guard finds the positions before the current step (World::step).
   enum class GuardCopy : std::uint8_t {
     none,         // in the previous positions: one substep's integration left them there untouched
