@@ -1,10 +1,10 @@
 // The engine's invariants, checked in the checking build and compiled out of the others.
 //
 // DRAPE_INVARIANT(condition, why) states what must hold at that point (a plan up to date before
-// the sweeps, a batch whose constraints share no particle). Where DRAPE_CHECK_INVARIANTS is defined (the CMake option of that name; on in the
-// sanitizer build tools/test runs) a broken one prints the condition, the reason and where, and
-// aborts. Elsewhere the condition is not evaluated (it still names what it reads, so nothing goes
-// unused) and costs nothing.
+// the sweeps, a batch whose constraints share no particle). Where DRAPE_CHECK_INVARIANTS is
+// defined (the CMake option of that name; on in the sanitizer build tools/test runs) a broken one
+// prints the condition, the reason and where, and aborts. Elsewhere the condition is not evaluated
+// (it still names what it reads, so nothing goes unused) and costs nothing.
 #pragma once
 
 namespace drape::sim {
