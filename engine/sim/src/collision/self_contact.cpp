@@ -224,11 +224,11 @@ std::size_t SelfContact::bytes() const {
   const auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   std::size_t total = b(clothOf_) + b(rest_) + b(clothSize_) + b(triangles_) + b(edges_) + b(edgeTriangles_) +
                       b(vertexStart_) + b(vertexTriangles_) + b(x0_) + b(x_) + b(w_) + b(planes_) + b(lower_) +
-                      b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(xMeasured_) +
-                      b(reach_) + b(primitiveReach_) + b(runNear_) + b(triangleMoved_) + b(zone_) + b(inZone_) +
-                      b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) + b(hits_) +
-                      b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_) + b(affected_) +
-                      b(strays_) + b(walk_) + b(refreshed_);
+                      b(upper_) + b(boxLower_) + b(boxUpper_) + b(pairs_) + b(contacts_) + b(active_) + b(x0Measured_) +
+                      b(xMeasured_) + b(reach_) + b(primitiveReach_) + b(runNear_) + b(triangleMoved_) + b(zone_) +
+                      b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) +
+                      b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_) +
+                      b(affected_) + b(strays_) + b(walk_) + b(refreshed_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(walkTests_) + b(boxTests_);
   for (const std::vector<std::uint64_t>& walked : walked_) total += b(walked);
@@ -1031,7 +1031,9 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
         }
       },
       1024);
-  xMeasured_ = x_;  // (what the pairs now carry was proven of the particles as they are)
+  // (What the pairs now carry was proven of the particles' paths as they are.)
+  x0Measured_ = x0_;
+  xMeasured_ = x_;
 }
 
 void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch) {

@@ -51,6 +51,7 @@
 // solved in it; the pairs' contacts are made in each thread's run of them, joined in that order.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -94,9 +95,10 @@ class SelfContact {
     // began, so not measured and not pushed.
     std::uint32_t contact;
     // How far apart its two primitives were proven to be, m, along a line (the one between their
-    // centres when it was last looked along), while each corner stays where it was when the pairs
-    // were last measured (xMeasured_); as they move from there, the proof holds less by as far as
-    // each side's corners went (SelfContact::proven). -inf: nothing proven (a new pair).
+    // centres when it was last looked along), while each corner stays on its path as the pairs
+    // were last measured (from x0Measured_ to xMeasured_); as they move off it, the proof holds
+    // less by as far as each side's corners went (SelfContact::proven). -inf: nothing proven (a new
+    // pair).
     float apart;
     bool edges;
     // Whether its two primitives lie at least the distance apart at rest (then they keep the
@@ -161,14 +163,21 @@ class SelfContact {
   Real proven(const Pair& pair) const;
   // primitiveReach_ from reach_: each triangle's and edge's farthest-gone corner.
   void reachOfPrimitives(Workers& workers);
-  // reach_ of particle i, from its motion (x0 too, or x alone) against where it was measured.
+  // reach_ of particle i: how far it now lies (x0 too, or x alone) from its path as it was
+  // measured, the segment from x0Measured_ to xMeasured_. A proof holds for every position on that
+  // path (it was made of the hull of both ends, or carried onto it), so a particle that goes back
+  // and forth along it (pushed out by the contacts' sweep and drawn back in by the constraints,
+  // substep after substep, in a pile at rest) takes nothing from its pairs' proofs.
   void reachOf(std::uint32_t i, bool fromX0) {
-    const Vec3 d = x_[i] - xMeasured_[i];
-    Real r = glm::dot(d, d);
-    if (fromX0) {
-      const Vec3 d0 = x0_[i] - xMeasured_[i];
-      r = std::max(r, glm::dot(d0, d0));
-    }
+    const Vec3 a = x0Measured_[i], along = xMeasured_[i] - a;
+    const Real length2 = glm::dot(along, along);
+    const auto from = [&](const Vec3& x) {
+      const Real t = length2 > 0.0 ? std::clamp(glm::dot(x - a, along) / length2, 0.0, 1.0) : 0.0;
+      const Vec3 d = x - (a + along * t);
+      return glm::dot(d, d);
+    };
+    Real r = from(x_[i]);
+    if (fromX0) r = std::max(r, from(x0_[i]));
     reach_[i] = std::sqrt(r);
   }
   void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
@@ -247,11 +256,12 @@ class SelfContact {
   std::vector<std::vector<Pair>> found_;  // per block of leaf pairs: vertex-triangle pairs, then edge-edge pairs
   std::vector<std::int64_t> boxTests_;    // per thread: primitive boxes compared
   std::vector<Pair> pairs_;
-  std::vector<Contact> contacts_;      // the pairs not far, in the pairs' order (then the fail-safe's)
-  std::vector<std::size_t> runNear_;   // measurePairs: where each run's contacts begin
-  std::vector<std::uint32_t> active_;  // contacts the sweeps look at
-  std::vector<Vec3> xMeasured_;        // x as the pairs were last measured
-  // Per particle: how far it has gone from xMeasured_ (now, and at x0 too where the measure asks).
+  std::vector<Contact> contacts_;             // the pairs not far, in the pairs' order (then the fail-safe's)
+  std::vector<std::size_t> runNear_;          // measurePairs: where each run's contacts begin
+  std::vector<std::uint32_t> active_;         // contacts the sweeps look at
+  std::vector<Vec3> x0Measured_, xMeasured_;  // x0 and x as the pairs were last measured
+  // Per particle: how far it has gone from the segment between them (now, and at x0 too where the
+  // measure asks).
   std::vector<Real> reach_;
   // Per triangle, then per edge: the largest reach_ of its corners (what proven() takes of a side),
   // so that a pair's proof reads two numbers, not its four corners'.
