@@ -228,7 +228,7 @@ std::size_t SelfContact::bytes() const {
                       b(xMeasured_) + b(reach_) + b(primitiveReach_) + b(runNear_) + b(triangleMoved_) + b(zone_) +
                       b(inZone_) + b(heavy_) + b(stays_) + b(staysRoot_) + b(stuck_) + b(everPassing_) + b(tests_) +
                       b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_) +
-                      b(affected_) + b(strays_) + b(walk_) + b(refreshed_);
+                      b(affected_) + b(movedTriangles_) + b(primitiveMoved_) + b(strays_) + b(walk_) + b(refreshed_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
            b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(walkTests_) + b(boxTests_);
   for (const std::vector<std::uint64_t>& walked : walked_) total += b(walked);
@@ -1129,6 +1129,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
   const std::size_t n = x_.size();
   keepPairs(nullptr, distance, workers);
   triangleMoved_.assign(triangles_.size(), 0);
+  movedTriangles_.clear();
   if (inZone_.size() != n) inZone_.assign(n, 0);
   if (stays_.size() != n) stays_.assign(n, 0);
   bool anyStays = false;                       // a zone stayed at x0 this substep (counted once in the fallbacks)
@@ -1315,6 +1316,7 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
     for (std::vector<std::uint64_t>& found : scanTests_) found.clear();
     for (auto& measured : scanContacts_) measured.clear();
     scanTested_.assign(threads, 0);
+    if (!everyPair) primitivesMoved();
     workers.run(
         pairs_.size(),
         [&](std::size_t begin, std::size_t end, int thread) {
@@ -1326,14 +1328,12 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
           std::int64_t tested = 0;
           for (std::size_t i = begin; i < end; ++i) {
             Pair& p = pairs_[i];
-            if (!everyPair) {
-              // After the first round, only pairs whose tests a zone's move changed.
-              bool moved = false;
-              eachTest(p, [&](std::uint32_t s, std::uint32_t u) {
-                moved = moved || triangleMoved_[s] || triangleMoved_[u];
-              });
-              if (!moved) continue;
-            }
+            // After the first round, only pairs whose tests (eachTest) a zone's move changed: where
+            // the pair has tests, and one of their triangles moved.
+            if (!everyPair && !(p.edges ? primitiveMoved_[n + p.first] + primitiveMoved_[n + p.second] >= 4
+                                        : primitiveMoved_[p.first] == 3 ||
+                                              (primitiveMoved_[p.first] != 0 && triangleMoved_[p.second])))
+              continue;
             // Proven apart all the way: by what the last measure proved, less how far its corners
             // went since; along the line between the centres (a far pair, or a near one whose
             // corners moved apart); or by the gap at x0 against the corners' relative motion.
@@ -1506,13 +1506,18 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
       weight[r] += mass;
     }
     std::fill(triangleMoved_.begin(), triangleMoved_.end(), 0);
+    movedTriangles_.clear();
     for (const std::uint32_t i : members) {
       const std::uint32_t r = root(i);
       stays_[i] = stays[r];
       const Vec3 moved = stays[r] ? x0_[i] : x0_[i] + sum[r] / weight[r];
       if (moved != x_[i]) {
         x_[i] = moved;
-        for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) triangleMoved_[vertexTriangles_[k]] = 1;
+        for (std::uint32_t k = vertexStart_[i]; k < vertexStart_[i + 1]; ++k) {
+          const std::uint32_t t = vertexTriangles_[k];
+          if (!triangleMoved_[t]) movedTriangles_.push_back(t);
+          triangleMoved_[t] = 1;
+        }
       }
     }
     for (const std::uint32_t t : whichX_) {
@@ -1530,6 +1535,26 @@ void SelfContact::failSafe(Real distance, Workers& workers) {
   }
   stats_.zoned += static_cast<std::int64_t>(members.size());
   for (const std::uint32_t i : members) inZone_[i] = stays_[i] = 0;
+}
+
+void SelfContact::primitivesMoved() {
+  // Per vertex (its triangles) and per edge (the one or two on it): 0 where it has none, 1 where
+  // none of them moved, 3 where one did. An edge pair then has tests, one of whose triangles moved,
+  // where its two marks sum to 4 or more (1 + 3, 3 + 3; not 0 + 3).
+  const std::size_t n = x_.size(), ne = edges_.size();
+  primitiveMoved_.assign(n + ne, 0);
+  for (std::uint32_t v = 0; v < n; ++v) primitiveMoved_[v] = vertexStart_[v + 1] > vertexStart_[v] ? 1 : 0;
+  for (const std::uint32_t t : movedTriangles_) {
+    for (int c = 0; c < 3; ++c) primitiveMoved_[triangles_[t][c]] = 3;
+  }
+  for (std::uint32_t e = 0; e < ne; ++e) {
+    std::uint8_t mark = 0;
+    for (int k = 0; k < 2; ++k) {
+      const std::uint32_t t = edgeTriangles_[2 * e + k];
+      if (t != kNone) mark = std::max<std::uint8_t>(mark, triangleMoved_[t] ? 3 : 1);
+    }
+    primitiveMoved_[n + e] = mark;
+  }
 }
 
 void SelfContact::scatter(std::vector<Cloth>& cloths) const {

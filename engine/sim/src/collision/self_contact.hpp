@@ -182,6 +182,8 @@ class SelfContact {
   }
   void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
   void failSafe(Real distance, Workers& workers);
+  // In the fail-safe's later rounds: primitiveMoved_ from movedTriangles_.
+  void primitivesMoved();
   // Of `candidates` (every particle where null), those not `margin` inside their boxes at x0 and
   // now (in strays_).
   const std::vector<std::uint32_t>& strays(const std::vector<std::uint32_t>* candidates, Real margin);
@@ -276,6 +278,9 @@ class SelfContact {
   // such pairs; and the substep's pairs through, every round's.
   std::vector<std::uint32_t> zone_;
   std::vector<std::uint8_t> inZone_, heavy_, triangleMoved_, stays_, staysRoot_;
+  std::vector<std::uint32_t> movedTriangles_;  // in a fail-safe round: those triangleMoved_ marks
+  // Per vertex, then per edge: 0 without triangles, 1 with, 3 where one of them moved this round.
+  std::vector<std::uint8_t> primitiveMoved_;
   std::vector<std::uint32_t> stuck_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> everPassing_;
   // Its exact tests: the pairs of triangles of a round (lower index in the high word) and whether
