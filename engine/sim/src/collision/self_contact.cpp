@@ -1025,6 +1025,9 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
             pair.contact = kFar;
             contact.gap0 = -1.0;
           } else {
+            // Near: it carries the better of its two proofs (the fail-safe reads it), and is
+            // measured again next substep all the same.
+            pair.apart = std::max(pair.apart, floatBelow(apart));
             pair.contact = next;
           }
           ++next;
