@@ -560,20 +560,22 @@ void World::timed(Stage stage, Work&& work) {
   timing->lastSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// A substep of the position model, stage by stage. Each runs where the pipeline has it
-// (buildPipeline): over every cloth, or over the world at once (fingers, self-collision and
-// self-contact span every cloth; colliders move once a substep).
+// A substep of the position model, stage by stage, over what the substep is (position::Substep:
+// the integrator's decay and reach, worked out once as it begins). Each runs where the pipeline
+// has it (buildPipeline): over every cloth, or over the world at once (fingers, self-collision
+// and self-contact span every cloth; colliders move once a substep).
 void World::positionSubstep(Real h) {
-  timed(Stage::fingers, [&](PartClock&) { moveFingers(h); });
+  const position::Substep substep = position::makeSubstep(settings_, h);
+  timed(Stage::fingers, [&](PartClock&) { moveFingers(substep.h); });
   timed(Stage::windPressure, [&](PartClock&) {
     for (std::size_t c = 0; c < cloths_.size(); ++c)
-      position::accumulateWindPressure(cloths_[c], settings_.air, h, scratch_[c].acceleration);
+      position::accumulateWindPressure(cloths_[c], settings_.air, substep.h, scratch_[c].acceleration);
   });
   timed(Stage::verletIntegrate, [&](PartClock&) {
     const bool keep = guardCopy_ == GuardCopy::integration && substep_ == 0;
     for (std::size_t c = 0; c < cloths_.size(); ++c) {
       std::vector<Vec3>& acceleration = scratch_[c].acceleration;
-      position::integrate(cloths_[c], settings_, h, acceleration.empty() ? nullptr : &acceleration, *workers_,
+      position::integrate(cloths_[c], substep, acceleration.empty() ? nullptr : &acceleration, *workers_,
                           keep ? lastGood_[c].data() : nullptr);
     }
   });
@@ -590,11 +592,11 @@ void World::positionSubstep(Real h) {
       // here, and the plan shows in the profile.)
       DRAPE_INVARIANT(scratch_[c].planVersion == topologyVersion_, "planAll ran after every change a plan is made of");
       if (scratch_[c].planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
-      position::projectConstraints(cloths_[c], settings_.solver, h, scratch_[c], colliders_, *workers_, parts);
+      position::projectConstraints(cloths_[c], settings_.solver, substep, scratch_[c], colliders_, *workers_, parts);
     }
   });
   timed(Stage::friction, [&](PartClock&) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, h, scratch_[c]);
+    for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, substep.h, scratch_[c]);
   });
   timed(Stage::selfContact, [&](PartClock& parts) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
@@ -602,7 +604,8 @@ void World::positionSubstep(Real h) {
                         settings_.solver.substeps - substep_, *workers_, &parts);
     if (!colliders_.empty()) {
       parts.time(Stage::friction, [&] {
-        for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, h, scratch_[c]);
+        for (std::size_t c = 0; c < cloths_.size(); ++c)
+          contact::friction(cloths_[c], colliders_, substep.h, scratch_[c]);
       });
     }
     selfContact_->finish(cloths_, settings_.selfCollision, *workers_, &parts);

@@ -9,6 +9,7 @@
 #include "solver/lines.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <functional>
@@ -84,15 +85,22 @@ void keptAll() {
 
 }  // namespace
 
-void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
-               Workers& workers, Vec3* keepPosition) {
-  ParticleState& s = cloth.state;
+Substep makeSubstep(const WorldSettings& world, Real h) {
   // Exact for du/dt = a - k u over one substep: u' = u e^{-kh} + a h (1 - e^{-kh}) / (k h).
   const Real kh = (world.solver.damping + world.air.drag) * h;
-  const Real decay = std::exp(-kh);
-  const Real relaxed = relaxation(kh);
-  const Vec3 constantAcceleration = world.gravity + world.air.drag * world.air.velocity;
-  const Real h2 = h * h * relaxed;
+  Substep substep;
+  substep.h = h;
+  substep.decay = std::exp(-kh);
+  substep.reach = h * h * relaxation(kh);
+  substep.acceleration = world.gravity + world.air.drag * world.air.velocity;
+  return substep;
+}
+
+void integrate(Cloth& cloth, const Substep& substep, const std::vector<Vec3>* extraAcceleration, Workers& workers,
+               Vec3* keepPosition) {
+  ParticleState& s = cloth.state;
+  const Real decay = substep.decay, h2 = substep.reach;
+  const Vec3 constantAcceleration = substep.acceleration;
   workers.run(
       s.position.size(),
       [&](std::size_t begin, std::size_t end, int) {
@@ -306,12 +314,27 @@ void projectBending(ParticleState& s, const std::vector<BendStencil>& stencils, 
   }
 }
 
-Real bendingAlphaTilde(const Cloth& cloth, Real h) { return 1.0 / (cloth.settings.fabric->bendingRigidity * h * h); }
+// A cloth's compliances over h^2 (XPBD's alpha tilde), each kind's and its fabric's bending's,
+// worked out once a substep as its constraints are projected.
+struct Compliances {
+  bool xpbd = false;  // the constraints resist with their compliance (solver.xpbd, or a fabric)
+  std::array<Real, kConstraintKindCount> kind{};
+  Real bending = 0.0;  // 1 / (B h^2), a fabric's bend stencils (0 without one)
+};
+
+Compliances compliancesOf(const Cloth& cloth, const SolverSettings& solver, Real h) {
+  Compliances c;
+  c.xpbd = solver.xpbd || cloth.settings.fabric;
+  for (ConstraintKind kind : kConstraintKinds)
+    c.kind[static_cast<std::size_t>(kind)] = cloth.settings.material(kind).compliance / (h * h);
+  if (cloth.settings.fabric) c.bending = 1.0 / (cloth.settings.fabric->bendingRigidity * h * h);
+  return c;
+}
 
 // A fabric's bend stencils: all at once where their block is narrow enough to factor (bending.hpp),
 // else one after another.
-void bend(Cloth& cloth, Real h, SolverScratch& scratch) {
-  const Real alphaTilde = bendingAlphaTilde(cloth, h);
+void bend(Cloth& cloth, const Compliances& compliances, SolverScratch& scratch) {
+  const Real alphaTilde = compliances.bending;
   if (scratch.bendingFactor.usable) {
     bending::project(scratch.bendingFactor, cloth.state, cloth.rest.bending, scratch.bendingLambda, alphaTilde);
   } else {
@@ -334,11 +357,11 @@ Stage partOf(ConstraintKind kind) {
 
 // The seed's sweep: a fabric's bend stencils, then every kind in order (stretch, shear, bend), each
 // constraint after the one before it in the order the cloth lists them, then the tethers. One thread.
-void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch, PartClock& parts) {
+void sweepInOrder(Cloth& cloth, const Compliances& compliances, SolverScratch& scratch, PartClock& parts) {
   ParticleState& s = cloth.state;
-  const bool xpbd = solver.xpbd || cloth.settings.fabric;
+  const bool xpbd = compliances.xpbd;
   // A fabric's bending first: the sweep ends with what the eye sees most, the cloth's length.
-  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, h, scratch); });
+  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, compliances, scratch); });
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
@@ -346,7 +369,7 @@ void sweepInOrder(Cloth& cloth, const SolverSettings& solver, Real h, SolverScra
     parts.time(partOf(kind), [&] {
       if (xpbd) {
         projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
-                              constraints.size(), material.compliance / (h * h));
+                              constraints.size(), compliances.kind[static_cast<std::size_t>(kind)]);
       } else {
         projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
       }
@@ -382,7 +405,7 @@ StretchPlan stretchPlan(const Cloth& cloth, const SolverSettings& solver, const 
 // The fast sweep (the lines stretch solver): tethers first, then bend and shear in batches shared
 // among the workers, then the stretch constraints a line at a time, last, so that a sweep ends with
 // what matters most to the eye, the cloth's length; the line solve as `plan` says (lines::solve).
-void sweepInBatches(Cloth& cloth, const SolverSettings& solver, const StretchPlan& plan, Real h, SolverScratch& scratch,
+void sweepInBatches(Cloth& cloth, const Compliances& compliances, const StretchPlan& plan, SolverScratch& scratch,
                     Workers& workers, PartClock& parts) {
   ParticleState& s = cloth.state;
   const auto tethers = [&] {
@@ -397,14 +420,14 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, const StretchPla
     });
   };
   tethers();
-  const bool xpbd = solver.xpbd || cloth.settings.fabric;
+  const bool xpbd = compliances.xpbd;
   // A fabric's bend stencils on one thread (not yet in batches).
-  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, h, scratch); });
+  if (!cloth.rest.bending.empty()) parts.time(Stage::bendStencils, [&] { bend(cloth, compliances, scratch); });
   for (ConstraintKind kind : {ConstraintKind::bend, ConstraintKind::shear, ConstraintKind::stretch}) {
     const std::size_t kindIndex = static_cast<std::size_t>(kind);
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
-    const Real alphaTilde = material.compliance / (h * h);
+    const Real alphaTilde = compliances.kind[kindIndex];
     if (kind == ConstraintKind::stretch) {
       const Real stiffness = xpbd ? 1.0 : material.stiffness;
       Real* looseLambda = scratch.lambda[kindIndex].data();
@@ -452,15 +475,16 @@ void sweepInBatches(Cloth& cloth, const SolverSettings& solver, const StretchPla
 
 }  // namespace
 
-void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch,
+void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Substep& substep, SolverScratch& scratch,
                         const std::vector<Collider>& colliders, Workers& workers, PartClock& parts) {
-  if (solver.xpbd || cloth.settings.fabric) {
+  const Compliances compliances = compliancesOf(cloth, solver, substep.h);
+  if (compliances.xpbd) {
     for (ConstraintKind kind : kConstraintKinds) {
       scratch.lambda[static_cast<std::size_t>(kind)].assign(cloth.rest.of(kind).size(), 0.0);
     }
     scratch.bendingLambda.assign(cloth.rest.bending.size(), Vec3{0.0});
     if (!cloth.rest.bending.empty()) {
-      bending::prepare(scratch.bendingFactor, cloth.rest.bending, cloth.state.inverseMass, bendingAlphaTilde(cloth, h));
+      bending::prepare(scratch.bendingFactor, cloth.rest.bending, cloth.state.inverseMass, compliances.bending);
     }
     if (solver.lines()) {
       for (SolverScratch::LineFamily& family : scratch.lines) family.lambda.assign(family.slots(), 0.0);
@@ -475,14 +499,14 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, Solv
     // summed over all of them blew up in four frames.
     scratch.sumTension = iteration == 0;
     if (solver.lines()) {
-      sweepInBatches(cloth, solver, plan, h, scratch, workers, parts);
+      sweepInBatches(cloth, compliances, plan, scratch, workers, parts);
     } else {
-      sweepInOrder(cloth, solver, h, scratch, parts);
+      sweepInOrder(cloth, compliances, scratch, parts);
     }
     if (!colliders.empty()) {
       parts.time(Stage::contactPlanes, [&] {
         contact::project(cloth, scratch);
-        contact::friction(cloth, colliders, h, scratch);
+        contact::friction(cloth, colliders, substep.h, scratch);
       });
     }
   }

@@ -26,14 +26,26 @@ void startHistory(Cloth& cloth, Vec3 acceleration, Real k, Real h);
 // f = pressure * area * ((wind - v) . n) n, shared equally by the triangle's three particles.
 void accumulateWindPressure(const Cloth& cloth, const AirSettings& air, Real h, std::vector<Vec3>& acceleration);
 
+// What a substep of the position model is, worked out once as it begins (World::positionSubstep)
+// and read by its rows: the integrator's share of velocity kept and its reach, the constant
+// acceleration; each cloth's compliances over h^2 follow from it as its constraints are projected
+// (Compliances).
+struct Substep {
+  Real h = 0.0;            // s
+  Real decay = 1.0;        // e^{-kh}, k = damping + drag: the share of its velocity a free particle keeps
+  Real reach = 0.0;        // h^2 (1 - e^{-kh}) / (kh): how far a constant acceleration moves it, per m/s^2
+  Vec3 acceleration{0.0};  // gravity + drag x the wind's velocity, m/s^2
+};
+Substep makeSubstep(const WorldSettings& world, Real h);
+
 // x' = x + (x - x_prev) e^{-kh} + a h^2 (1 - e^{-kh}) / (kh),  k = damping + drag,
 // a = g + drag wind + a_extra. With k = 0 this is the seed's Verlet step; with k > 0 it is the exact
 // solution of du/dt = a - k u over the substep, so no damping or drag can make it overshoot and a
 // falling particle reaches exactly the terminal velocity a / k. Pinned particles (inverse mass 0)
 // do not move. With `keepPosition` each particle's position is also copied there as it was before
 // the step (the guard's copy, made in the same pass).
-void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vector<Vec3>* extraAcceleration,
-               Workers& workers, Vec3* keepPosition = nullptr);
+void integrate(Cloth& cloth, const Substep& substep, const std::vector<Vec3>* extraAcceleration, Workers& workers,
+               Vec3* keepPosition = nullptr);
 
 // `solver.iterations` Gauss-Seidel sweeps over the stretch, shear and bend constraints, in the
 // batches of scratch (batches.hpp; built for the cloth's current constraints). Each violated
@@ -49,7 +61,7 @@ void integrate(Cloth& cloth, const WorldSettings& world, Real h, const std::vect
 // stretch constraints are solved a line at a time (lines.hpp; scratch.lines built). Batches, lines and tethers are
 // shared among the workers: the result does not depend on how many there are. Each part (tethers, each kind, the loose
 // links, the contact planes) is timed by `parts`.
-void projectConstraints(Cloth& cloth, const SolverSettings& solver, Real h, SolverScratch& scratch,
+void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Substep& substep, SolverScratch& scratch,
                         const std::vector<Collider>& colliders, Workers& workers, PartClock& parts);
 
 // Removes the kind's damping fraction of the relative velocity along each constraint, by moving
