@@ -342,30 +342,6 @@ void bend(Cloth& cloth, const Compliances& compliances, SolverScratch& scratch) 
   }
 }
 
-// The self-contacts the substep before pushed (SolverScratch::layerContacts), each once, as its
-// sweeps push them (self_contact.cpp): sum_k c_k (n . x_k) >= target, the masses sharing the move,
-// none where that would move a particle far more than the two points part, nor where the two points
-// no longer face each other across the normal (one slid off the other's side since).
-void holdLayers(Cloth& cloth, const SolverScratch& scratch) {
-  std::vector<Vec3>& x = cloth.state.position;
-  const std::vector<Real>& w = cloth.state.inverseMass;
-  for (const SolverScratch::LayerContact& p : scratch.layerContacts) {
-    Real denominator = 0.0, most = 0.0;
-    Vec3 between{0.0};
-    for (int k = 0; k < 4; ++k) {
-      between += x[p.v[k]] * p.c[k];
-      denominator += p.c[k] * p.c[k] * w[p.v[k]];
-      most = std::max(most, std::abs(p.c[k]) * w[p.v[k]]);
-    }
-    const Real length = glm::length(between);
-    const Vec3 normal = glm::dot(between, p.normal) > 0.0 && length > 0.0 ? between / length : p.normal;
-    const Real gap = glm::dot(between, normal) - p.target;
-    if (gap >= 0.0 || !(denominator > SolverScratch::kContactLeverage * most) || !contact::facing(x, p)) continue;
-    const Real lambda = -gap / denominator;
-    for (int k = 0; k < 4; ++k) x[p.v[k]] += normal * (p.c[k] * w[p.v[k]] * lambda);
-  }
-}
-
 }  // namespace
 
 namespace {
@@ -527,7 +503,6 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Subste
     } else {
       sweepInOrder(cloth, compliances, scratch, parts);
     }
-    if (!scratch.layerContacts.empty()) parts.time(Stage::layerContacts, [&] { holdLayers(cloth, scratch); });
     if (!colliders.empty()) {
       parts.time(Stage::contactPlanes, [&] {
         contact::project(cloth, scratch);
