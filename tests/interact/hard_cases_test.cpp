@@ -119,7 +119,10 @@ TEST(HardCase, APinchLiftedAndLoweredOntoTheRestLiesOnItWithoutPassingThrough) {
   played.until(1.8);
   EXPECT_GT(highest(played.cloth()), 0.2);
   played.until();
-  EXPECT_LT(highest(played.cloth()), 0.1);  // lowered and let go
+  // Lowered and let go, it lies as a pile, far under the 25 cm it was lifted to. How tall the pile
+  // stands is chance: 8.6 to 13.1 cm with the self-contact distance moved by 1e-7 of itself
+  // (docs/self-contact.md).
+  EXPECT_LT(highest(played.cloth()), 0.15);
   EXPECT_GT(lowest(played.cloth()), 0.0);
   EXPECT_EQ(played.worstIntersections, 0u) << "at step " << played.worstStep;
 }

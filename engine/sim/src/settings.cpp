@@ -119,6 +119,7 @@ std::string_view name(Stage stage) {
     case Stage::stretch: return "stretch";
     case Stage::looseLinks: return "loose links";
     case Stage::contactPlanes: return "contact planes";
+    case Stage::layerContacts: return "layer contacts";
     case Stage::broadPhase: return "broad phase";
     case Stage::narrowPhase: return "narrow phase";
     case Stage::contactSweep: return "contact sweep";

@@ -442,9 +442,9 @@ MemoryUse World::memoryUse() const {
   for (const SolverScratch& s : scratch_) {
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
-                bytes(s.contactDepth) + bytes(s.contactRub) + bytes(s.lambda) + bytes(s.bendingLambda) +
-                bytes(s.looseStretch) + bytes(s.lineNormal) + bytes(s.lineUpper) + bytes(s.lineSolution) +
-                bytes(s.lineStiff) + bytes(s.batchStart) + bytes(s.bendingFactor.stencils) +
+                bytes(s.contactDepth) + bytes(s.contactRub) + bytes(s.layerContacts) + bytes(s.lambda) +
+                bytes(s.bendingLambda) + bytes(s.looseStretch) + bytes(s.lineNormal) + bytes(s.lineUpper) +
+                bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart) + bytes(s.bendingFactor.stencils) +
                 bytes(s.bendingFactor.inverseMass) + bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work) +
                 bytes(s.bendingFactor.rank);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
@@ -716,6 +716,8 @@ StepStatus World::step() {
     timing.lastSeconds = 0.0;
     for (StageTiming& part : timing.parts) part.lastSeconds = 0.0;
   }
+  // A step starts from its state alone: the layers' contacts its substeps hand on begin empty.
+  for (SolverScratch& scratch : scratch_) scratch.layerContacts.clear();
   const Real h = static_cast<Real>(substepDt());
   for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
     substep_ = substep;

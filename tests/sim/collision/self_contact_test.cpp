@@ -241,19 +241,21 @@ TEST(SelfContact, AFingerDraggedAcrossTheClothAt5MetresASecondNeverPullsItThroug
   std::size_t worst = 0;
   const Real perStep = 5.0 * world.settings().solver.dt / std::sqrt(2.0);
   // Twelve steps take it 1 m, from its own corner to just past the far one. (It went on for 24, 1.1 m
-  // beyond the cloth, which then slid after the finger and was flung: whether it landed folded was chance.)
+  // beyond the cloth, which then slid after the finger and was flung.) Where it lands is chance: the
+  // whole cloth slides after the finger, and lands folded or flat (folded before the layers' contacts
+  // were held within the sweeps, 1.7 m on; flat since, 0.5 m on).
+  Real highest = 0.0;
   for (int step = 1; step <= 12; ++step) {
     ASSERT_TRUE(world.moveFinger(1, {-0.3 + perStep * step, 0.03, -0.3 + perStep * step}));
     ASSERT_EQ(world.step(), StepStatus::ok);
     worst = std::max(worst, countIntersections(world).pairs);
+    for (const Vec3& x : world.cloths()[0].state.position) highest = std::max(highest, x.y);
   }
+  // The corner went over the rest: the cloth stood in a fold far above the finger's 3 cm.
+  EXPECT_GT(highest, 0.1);
   world.releaseFinger(1);
   worst = std::max(worst, worstWhileRunning(world, 60));
   EXPECT_EQ(worst, 0u);
-  // The corner went over: the cloth lies folded on itself.
-  Real highest = 0.0;
-  for (const Vec3& x : world.cloths()[0].state.position) highest = std::max(highest, x.y);
-  EXPECT_GT(highest, 0.005 + 0.8 * kDistance);
 }
 
 // Two triangles that share an edge, the free corner d of the second thrown through the first:

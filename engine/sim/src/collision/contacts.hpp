@@ -7,7 +7,10 @@
 // so constraints and contacts agree. `friction` then applies Coulomb friction in position form.
 #pragma once
 
+#include <algorithm>
 #include <vector>
+
+#include <glm/geometric.hpp>
 
 #include "drape/sim/collider.hpp"
 #include "drape/sim/settings.hpp"
@@ -42,5 +45,25 @@ void clampTravel(Cloth& cloth, Real maxTravel);
 // Works across all cloths of the world, so two cloths collide with each other too.
 void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
                  Workers& workers);
+
+// Whether a self-contact's two points (its weights c over corners v, self_contact.hpp's Contact or a
+// SolverScratch::LayerContact) still face each other across its normal at `x`: their offset along
+// the surface within the size of the primitives (else one slid off the other's side, or a finger
+// flung it far, and the half-space it was measured in says nothing about them).
+template <class Contact>
+bool facing(const std::vector<Vec3>& x, const Contact& p) {
+  Vec3 offset{0.0};
+  for (int k = 0; k < 4; ++k) offset += x[p.v[k]] * p.c[k];
+  const Vec3 along = offset - p.normal * glm::dot(p.normal, offset);
+  Real size = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i + 1; j < 4; ++j) {
+      const Vec3 d = x[p.v[i]] - x[p.v[j]];
+      const bool within = p.edges ? (j < 2 || i >= 2) : i >= 1;  // two corners of one primitive
+      if (within) size = std::max(size, glm::dot(d, d));
+    }
+  }
+  return glm::dot(along, along) <= size + p.target * p.target;
+}
 
 }  // namespace drape::sim::contact

@@ -8,6 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "collision/contacts.hpp"
 #include "collision/exact_triangles.hpp"
 
 namespace drape::sim::contact {
@@ -77,10 +78,7 @@ int signChangesIn01(const std::array<Real, 4>& c, std::array<Real, 3>& roots) {
 }
 // Two points closer than this at x0 give no direction to keep apart along.
 constexpr Real kCoincident = 1e-12;
-// A pair whose free corners would each move more than 1 / kLeverage times as far as its points part
-// pushes nothing: a free corner of weight 0.004 in a triangle whose other corners and the vertex
-// fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair apart instead.
-constexpr Real kLeverage = 0.25;
+constexpr Real kLeverage = SolverScratch::kContactLeverage;
 // A pair's separation where nothing is proven.
 constexpr float kUnproven = -std::numeric_limits<float>::infinity();
 // How many times its rest size a triangle or edge may be stretched and still take part (longer
@@ -244,8 +242,10 @@ void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
   rest_.clear();
   clothSize_.clear();
   triangles_.clear();
+  clothStart_.clear();
   for (std::size_t c = 0; c < cloths.size(); ++c) {
     const auto base = static_cast<std::uint32_t>(clothOf_.size());
+    clothStart_.push_back(base);
     const Cloth& cloth = cloths[c];
     // The cloth's size at rest: the diagonal of its rest shape's box, squared (0 with no particle).
     Vec3 lo(std::numeric_limits<Real>::max()), hi(std::numeric_limits<Real>::lowest());
@@ -1058,23 +1058,7 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
     if (!(denominator > kLeverage * most)) return 0.0;
     return 1.0 / denominator;
   };
-  // Whether the two points still face each other across the normal: their offset along the
-  // surface within the size of the primitives (else one slid off the other's side, or a finger
-  // flung it far, and the half-space of x0 says nothing about them).
-  const auto facing = [&](const Contact& p) {
-    Vec3 offset{0.0};
-    for (int k = 0; k < 4; ++k) offset += x_[p.v[k]] * p.c[k];
-    const Vec3 along = offset - p.normal * glm::dot(p.normal, offset);
-    Real size = 0.0;
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i + 1; j < 4; ++j) {
-        const Vec3 d = x_[p.v[i]] - x_[p.v[j]];
-        const bool within = p.edges ? (j < 2 || i >= 2) : i >= 1;  // two corners of one primitive
-        if (within) size = std::max(size, glm::dot(d, d));
-      }
-    }
-    return glm::dot(along, along) <= size + p.target * p.target;
-  };
+  const auto facing = [&](const Contact& p) { return contact::facing(x_, p); };
   // The pairs a sweep can push: within one more `distance` of their target now.
   active_.clear();
   for (std::uint32_t i = 0; i < contacts_.size(); ++i) {
@@ -1101,6 +1085,23 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
     }
   }
   std::int64_t pushed = 0;
+  // What the sweeps pushed, for the next substep's constraint sweeps (SolverScratch::layerContacts).
+  for (SolverScratch& each : scratch) each.layerContacts.clear();
+  for (const std::uint32_t i : active) {
+    const Contact& p = contacts_[i];
+    if (p.push <= 0.0) continue;
+    const std::uint32_t c = clothOf_[p.v[0]];
+    if (clothOf_[p.v[1]] != c || clothOf_[p.v[2]] != c || clothOf_[p.v[3]] != c) continue;
+    SolverScratch::LayerContact held;
+    for (int k = 0; k < 4; ++k) {
+      held.v[k] = p.v[k] - clothStart_[c];
+      held.c[k] = p.c[k];
+    }
+    held.normal = p.normal;
+    held.target = p.target;
+    held.edges = p.edges;
+    scratch[c].layerContacts.push_back(held);
+  }
   for (const std::uint32_t i : active) {
     Contact& p = contacts_[i];
     if (p.push <= 0.0) continue;

@@ -207,6 +207,7 @@ class SelfContact {
   std::size_t meshParticles_ = 0;
   // The world's mesh, particles numbered across cloths.
   std::vector<std::uint32_t> clothOf_;                        // per particle
+  std::vector<std::uint32_t> clothStart_;                     // per cloth: its first particle
   std::vector<Vec3> rest_;                                    // rest positions
   std::vector<Real> clothSize_;                               // per cloth: its rest box's diagonal, squared
   std::vector<glm::uvec3> triangles_;                         // world-wide corners

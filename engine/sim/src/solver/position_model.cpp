@@ -342,6 +342,41 @@ void bend(Cloth& cloth, const Compliances& compliances, SolverScratch& scratch) 
   }
 }
 
+// The self-contacts the substep before pushed (SolverScratch::layerContacts), each once, as its
+// sweeps push them (self_contact.cpp): sum_k c_k (n . x_k) >= target, the masses sharing the move,
+// none where that would move a particle far more than the two points part, nor where the two points
+// no longer face each other across the normal (one slid off the other's side since).
+void holdLayers(Cloth& cloth, const SolverScratch& scratch) {
+  std::vector<Vec3>& x = cloth.state.position;
+  const std::vector<Real>& w = cloth.state.inverseMass;
+  for (const SolverScratch::LayerContact& p : scratch.layerContacts) {
+    Real denominator = 0.0, most = 0.0;
+    Vec3 between{0.0};
+    for (int k = 0; k < 4; ++k) {
+      between += x[p.v[k]] * p.c[k];
+      denominator += p.c[k] * p.c[k] * w[p.v[k]];
+      most = std::max(most, std::abs(p.c[k]) * w[p.v[k]]);
+    }
+    // Across the surface as it is now: the triangle's normal, or both edges', turned the way the
+    // measured one faces (that one where they turned more than 60 degrees since). The line between
+    // the two points (fixed on each layer) tilts as the layers slide, and would push them sideways
+    // too; the measured normal is stale where a fast finger turned the triangle.
+    const Vec3 across = p.edges ? glm::cross(x[p.v[1]] - x[p.v[0]], x[p.v[3]] - x[p.v[2]])
+                                : glm::cross(x[p.v[2]] - x[p.v[1]], x[p.v[3]] - x[p.v[1]]);
+    const Real length = glm::length(across);
+    Vec3 normal = p.normal;
+    if (length > 0.0) {
+      const Vec3 unit = across / length;
+      const Real facing = glm::dot(unit, p.normal);
+      if (std::abs(facing) > 0.5) normal = facing > 0.0 ? unit : -unit;
+    }
+    const Real gap = glm::dot(between, normal) - p.target;
+    if (gap >= 0.0 || !(denominator > SolverScratch::kContactLeverage * most) || !contact::facing(x, p)) continue;
+    const Real lambda = -gap / denominator;
+    for (int k = 0; k < 4; ++k) x[p.v[k]] += normal * (p.c[k] * w[p.v[k]] * lambda);
+  }
+}
+
 }  // namespace
 
 namespace {
@@ -503,6 +538,7 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Subste
     } else {
       sweepInOrder(cloth, compliances, scratch, parts);
     }
+    if (!scratch.layerContacts.empty()) parts.time(Stage::layerContacts, [&] { holdLayers(cloth, scratch); });
     if (!colliders.empty()) {
       parts.time(Stage::contactPlanes, [&] {
         contact::project(cloth, scratch);

@@ -43,6 +43,24 @@ struct SolverScratch {
   std::vector<Real> contactOffset;  // m
   std::vector<Real> contactDepth;   // m, penetration resolved this substep (for friction)
   std::vector<Vec3> contactRub;     // m, the friction's tangential correction so far this substep
+  // The self-contacts the last substep of this step pushed apart with all four corners in this
+  // cloth (in its own numbering; self_contact.hpp's Contact): held again after each of this
+  // substep's constraint sweeps (position::projectConstraints), so that the sweeps settle with the
+  // layers apart instead of drawing them together for the contacts to push apart once more.
+  // Emptied as each step begins: a step starts from its state alone (a snapshot, a tear).
+  // A contact whose free corners would each move more than 1 / kContactLeverage times as far as
+  // its points part pushes nothing: a free corner of weight 0.004 in a triangle whose other corners
+  // and the vertex fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair
+  // apart instead.
+  static constexpr Real kContactLeverage = 0.25;
+  struct LayerContact {
+    ParticleIndex v[4];
+    Real c[4];    // the weights of its two points: sum_k c_k (n . x_k) >= target
+    Vec3 normal;  // at the substep's x0, where it was measured
+    Real target;  // m
+    bool edges;   // edge and edge (corners 0, 1 and 2, 3), else vertex 0 and triangle 1, 2, 3
+  };
+  std::vector<LayerContact> layerContacts;
   // XPBD: the Lagrange multiplier of every constraint, by kind, reset each substep.
   std::array<std::vector<Real>, kConstraintKindCount> lambda;
   std::vector<Vec3> bendingLambda;  // a fabric's bend stencils (XPBD, a vector multiplier each), reset each substep

@@ -4,8 +4,8 @@
 // pressure on a windless scene, constraint damping on undamped constraints, the other model's
 // integrator) is simply absent and costs nothing. Every stage is timed into a Profile, and so is
 // every part of a stage that does several jobs (projecting constraints: the plan, the tethers, each
-// kind's constraints, the loose links, the contact planes; self-contact: the broad and the narrow phase, the sweeps,
-// friction, the fail-safe), as the stage's parts.
+// kind's constraints, the loose links, the contact planes, the layers' contacts; self-contact: the broad and the narrow
+// phase, the sweeps, friction, the fail-safe), as the stage's parts.
 #pragma once
 
 #include <cstdint>
@@ -46,6 +46,7 @@ enum class Stage : std::uint8_t {
   stretch,        // the stretch constraints (whole lines at a time with the lines stretch solver)
   looseLinks,     // with the lines stretch solver: the stretch links on no line, one at a time
   contactPlanes,  // each particle back onto its collider contacts' planes, after each sweep
+  layerContacts,  // the self-contacts the substep before pushed, held again after each sweep
   // parts of selfContact (friction, above, is its part too)
   broadPhase,    // the vertex-triangle and edge-edge pairs that may come within reach (a tree of boxes)
   narrowPhase,   // each pair's closest points, and whether it is near enough to push
