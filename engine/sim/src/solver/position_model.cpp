@@ -342,6 +342,9 @@ void bend(Cloth& cloth, const Compliances& compliances, SolverScratch& scratch) 
   }
 }
 
+// The sine of the angle two edges or a triangle's sides must make for their cross to be a normal.
+constexpr Real kLeastSine = 0.25;
+
 // The self-contacts the substep before pushed (SolverScratch::layerContacts), each once, as its
 // sweeps push them (self_contact.cpp): sum_k c_k (n . x_k) >= target, the masses sharing the move,
 // none where that would move a particle far more than the two points part, nor where the two points
@@ -358,14 +361,17 @@ void holdLayers(Cloth& cloth, const SolverScratch& scratch) {
       most = std::max(most, std::abs(p.c[k]) * w[p.v[k]]);
     }
     // Across the surface as it is now: the triangle's normal, or both edges', turned the way the
-    // measured one faces (that one where they turned more than 60 degrees since). The line between
-    // the two points (fixed on each layer) tilts as the layers slide, and would push them sideways
-    // too; the measured normal is stale where a fast finger turned the triangle.
-    const Vec3 across = p.edges ? glm::cross(x[p.v[1]] - x[p.v[0]], x[p.v[3]] - x[p.v[2]])
-                                : glm::cross(x[p.v[2]] - x[p.v[1]], x[p.v[3]] - x[p.v[1]]);
+    // measured one faces (that one where they turned more than 60 degrees since, or where the two
+    // edges, or the triangle's two sides, lie within 14 degrees of parallel, so that their cross
+    // points nowhere in particular). The line between the two points (fixed on each layer) tilts
+    // as the layers slide, and would push them sideways too; the measured normal is stale where a
+    // fast finger turned the triangle.
+    const Vec3 a = p.edges ? x[p.v[1]] - x[p.v[0]] : x[p.v[2]] - x[p.v[1]];
+    const Vec3 b = p.edges ? x[p.v[3]] - x[p.v[2]] : x[p.v[3]] - x[p.v[1]];
+    const Vec3 across = glm::cross(a, b);
     const Real length = glm::length(across);
     Vec3 normal = p.normal;
-    if (length > 0.0) {
+    if (length > kLeastSine * glm::length(a) * glm::length(b)) {
       const Vec3 unit = across / length;
       const Real facing = glm::dot(unit, p.normal);
       if (std::abs(facing) > 0.5) normal = facing > 0.0 ? unit : -unit;
