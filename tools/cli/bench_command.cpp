@@ -183,12 +183,24 @@ int bench(const BenchArguments& input) {
     }
     // The scenes people touch, smallest first: one run each (touch_bench.hpp).
     std::vector<TouchRow> touched;
+    std::vector<TouchSpread> spreads;
     for (int n : arguments.touchSizes) {
       for (const TouchCase& c : cases) {
         for (int t : arguments.threads) {
           touched.push_back(playTouchCase(c, n, t, arguments.touchBudget));
           if (!arguments.quiet) {
             std::printf("%s\n", touchLine(touched.back()).c_str());
+            std::fflush(stdout);
+          }
+        }
+        // The spread over chance, of the run on the most threads (every thread count ends the same),
+        // where it played whole.
+        const TouchRow& timed = touched.back();
+        if (arguments.touchSpread > 0 && !timed.diverged && timed.framesRun == timed.frames) {
+          spreads.push_back(spreadTouchCase(c, timed, arguments.touchSpread, timed.threads, arguments.touchBudget));
+          if (!arguments.quiet) {
+            std::printf("%-13s %4d x %-4d spread over %zu runs\n", c.name.c_str(), n, n,
+                        spreads.back().freeStrainWorst.size());
             std::fflush(stdout);
           }
         }
@@ -419,7 +431,7 @@ int bench(const BenchArguments& input) {
       report << " total " << format("%.1f", static_cast<double>(row.m.bytes) / static_cast<double>(row.m.particles))
              << ".\n";
     }
-    if (!touched.empty()) report << "\n" << touchSection(touched, arguments.touchBudget);
+    if (!touched.empty()) report << "\n" << touchSection(touched, arguments.touchBudget, spreads);
     report << "\nPeak resident memory of the whole benchmark process: " << format("%.0f", peakMiB) << " MiB.\n";
 
     std::error_code error;
@@ -429,7 +441,8 @@ int bench(const BenchArguments& input) {
         {{directory / "performance.csv", csv.str()},
          {directory / "performance.dat", plotData(rows, arguments.threads, arguments.naiveIterations)},
          {directory / "performance.gp", plotScript(arguments.threads, arguments.naiveIterations)},
-         {directory / "touch.csv", touchCsv(touched)}});
+         {directory / "touch.csv", touchCsv(touched)},
+         {directory / "touch-spread.csv", touchSpreadCsv(spreads)}});
     drawWithGnuplot(directory, "performance.gp", "performance.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {

@@ -83,7 +83,8 @@ struct BenchArguments {
   std::vector<std::string> scenes{"drape-sphere", "hang2-tear"};  // more scenes (Drape's solver only)
   std::vector<int> touchSizes{64, 128, 256};  // the scenes people touch at N x N (touch_bench.hpp); 0: none
   double touchBudget = 60.0;                  // s of stepping a touch case may take before it stops
-  std::vector<std::string> touchCases;        // by name ("desk crumple"); empty: every one
+  int touchSpread = 4;  // more untimed runs of each whole touch case, gravity moved by k x 1e-7 (touch_bench.hpp)
+  std::vector<std::string> touchCases;  // by name ("desk crumple"); empty: every one
   int frames = 120;
   int repeats = 5;                   // timed runs (median); fewer once a case has taken 20 s
   int substeps = 0;                  // Drape's hang2 substeps (of one sweep); 0: the cheapest sweep within 5 % strain

@@ -182,6 +182,12 @@ int main(int argc, char** argv) {
       ->add_option("--touch-budget", benchArguments.touchBudget,
                    "Seconds of stepping a touch case may take; it stops there and says how far it got (default 60)")
       ->check(CLI::Range(0.001, 1.0e6));
+  benchCommand
+      ->add_option("--touch-spread", benchArguments.touchSpread,
+                   "More untimed runs of each touch case that played whole, gravity moved by k x 1e-7 of itself, "
+                   "for how far the strain and the pairs spread over chance (default 4; 0: none)")
+      ->transform(kDecimal)
+      ->check(CLI::Range(0, 100));
   benchCommand->add_option("--frames", benchArguments.frames, "Frames per run (default 120)")
       ->transform(kDecimal)
       ->check(CLI::Range(1, 100000));
@@ -230,6 +236,7 @@ int main(int argc, char** argv) {
         if (benchCommand->count("--naive-iterations") == 0) benchArguments.naiveIterations = {10};
         if (benchCommand->count("--touch-sizes") == 0) benchArguments.touchSizes = {8};
         if (benchCommand->count("--touch-budget") == 0) benchArguments.touchBudget = 2.0;
+        if (benchCommand->count("--touch-spread") == 0) benchArguments.touchSpread = 0;
       }
       return bench(benchArguments);
     }

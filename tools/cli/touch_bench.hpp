@@ -43,12 +43,30 @@ struct TouchRow {
   std::uint64_t hash = 0;  // the final state's (sim::stateHash): 1 and N threads must agree
 };
 
-// Plays `c` at n x n on `threads` threads, for at most `budgetSeconds` of stepping.
-TouchRow playTouchCase(const TouchCase& c, int n, int threads, double budgetSeconds);
+// Plays `c` at n x n on `threads` threads, for at most `budgetSeconds` of stepping, with the scene's
+// gravity times `gravityScale`.
+TouchRow playTouchCase(const TouchCase& c, int n, int threads, double budgetSeconds, double gravityScale = 1.0);
+
+// How a case's outcome spreads over chance: the free strain and the intersecting pairs of its timed
+// run and of `runs` more, each with gravity moved by k x 1e-7 of itself (k = 1 .. runs). A crumple,
+// a fold or a tear is chaotic: runs that differ in the seventh digit end in different piles, and one
+// run's worst link says little.
+struct TouchSpread {
+  std::string name;
+  int n = 0;
+  std::vector<double> freeStrainWorst;  // a run each, the timed one first
+  std::vector<double> freeStrainEnd;
+  std::vector<std::size_t> pairsWorst;
+  int notWhole = 0;  // the more runs that a budget stopped or that diverged (left out above)
+};
+// Plays the more runs of the timed run `timed` (which must have played whole) on `threads` threads.
+TouchSpread spreadTouchCase(const TouchCase& c, const TouchRow& timed, int runs, int threads, double budgetSeconds);
 
 // The report's section (Markdown), its CSV, and a one-line summary for the console.
-std::string touchSection(const std::vector<TouchRow>& rows, double budgetSeconds);
+std::string touchSection(const std::vector<TouchRow>& rows, double budgetSeconds,
+                         const std::vector<TouchSpread>& spreads = {});
 std::string touchCsv(const std::vector<TouchRow>& rows);
+std::string touchSpreadCsv(const std::vector<TouchSpread>& spreads);
 std::string touchLine(const TouchRow& row);
 
 }  // namespace drape::cli
