@@ -360,6 +360,7 @@ void holdLayers(Cloth& cloth, const SolverScratch& scratch) {
       denominator += p.c[k] * p.c[k] * w[p.v[k]];
       most = std::max(most, std::abs(p.c[k]) * w[p.v[k]]);
     }
+    if (!(denominator > SolverScratch::kContactLeverage * most)) continue;
     // Across the surface as it is now: the triangle's normal, or both edges', turned the way the
     // measured one faces (that one where they turned more than 60 degrees since, or where the two
     // edges, or the triangle's two sides, lie within 14 degrees of parallel, so that their cross
@@ -377,7 +378,7 @@ void holdLayers(Cloth& cloth, const SolverScratch& scratch) {
       if (std::abs(facing) > 0.5) normal = facing > 0.0 ? unit : -unit;
     }
     const Real gap = glm::dot(between, normal) - p.target;
-    if (gap >= 0.0 || !(denominator > SolverScratch::kContactLeverage * most) || !contact::facing(x, p)) continue;
+    if (gap >= 0.0 || !contact::facing(x, p)) continue;
     const Real lambda = -gap / denominator;
     for (int k = 0; k < 4; ++k) x[p.v[k]] += normal * (p.c[k] * w[p.v[k]] * lambda);
   }
