@@ -51,7 +51,7 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
   fabric_.clear();
   interaction_ = std::make_unique<interact::Interaction>(*world_);
   interaction_->settings().material = scene::drawnClothTemplate(scene_);
-  interaction_->beforeCut = [this] { undo_.push_back({Undo::Kind::cut, world_->cloths()}); };
+  interaction_->beforeCut = [this] { undo_.push_back({Undo::Kind::cut, world_->cloths().copy()}); };
   interaction_->cutNothing = [this] {
     if (!undo_.empty() && undo_.back().kind == Undo::Kind::cut) undo_.pop_back();
   };
@@ -90,7 +90,7 @@ void takeMotion(sim::ParticleState& s, const sim::ParticleState& current, std::s
 // of each cloth now are the particles before it, where they are now. Positions, previous positions
 // (so velocities), velocities and pins come from now; rest data and masses from before, so the
 // mass is exactly what it was. Where the cloths do not match so (a cloth fewer), `before` as it is.
-std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const std::vector<sim::Cloth>& now) {
+std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const sim::ClothList& now) {
   if (before.size() != now.size()) return before;
   for (std::size_t c = 0; c < before.size(); ++c) {
     if (now[c].state.position.size() < before[c].state.position.size()) return before;
@@ -107,7 +107,7 @@ std::vector<sim::Cloth> withMotionSince(std::vector<sim::Cloth> before, const st
 // the particles beside it (in `after`'s triangles, on its own side of the cut) moved on average. A
 // cut or tear keeps each particle's index and appends the new ones (topology.cpp). Where the
 // cloths do not match so, `after` as it is.
-std::vector<sim::Cloth> withMotionAfter(std::vector<sim::Cloth> after, const std::vector<sim::Cloth>& now) {
+std::vector<sim::Cloth> withMotionAfter(std::vector<sim::Cloth> after, const sim::ClothList& now) {
   if (after.size() != now.size()) return after;
   for (std::size_t c = 0; c < after.size(); ++c) {
     if (after[c].state.position.size() < now[c].state.position.size()) return after;
@@ -345,7 +345,7 @@ sim::StepStatus Session::step() {
   const bool tearing = world_->settings().tearing.enabled;
   const std::uint64_t version = world_->topologyVersion();
   if (tearing && version != shapeVersion_) {
-    shape_ = world_->cloths();
+    shape_ = world_->cloths().copy();
     shapeVersion_ = version;
   }
   const sim::StepStatus result = world_->step();
@@ -386,7 +386,7 @@ bool Session::undo() {
     interaction_->undoSpawn();
     status = "took back the last drawn cloth";
   } else {
-    redo_.push_back({last.kind, world_->cloths()});
+    redo_.push_back({last.kind, world_->cloths().copy()});
     world_->restoreCloths(withMotionSince(std::move(last.cloths), world_->cloths()));
     status = last.kind == Undo::Kind::cut ? "took back the last cut" : "took back the last tear";
   }
@@ -403,14 +403,14 @@ bool Session::redo() {
   redo_.pop_back();
   interaction_->cancelAll();
   if (next.kind == Undo::Kind::spawn) {
-    std::vector<sim::Cloth> cloths = world_->cloths();
+    std::vector<sim::Cloth> cloths = world_->cloths().copy();
     cloths.push_back(std::move(next.cloths.front()));
     world_->restoreCloths(std::move(cloths));
     interaction_->noteSpawned(static_cast<int>(world_->cloths().size()) - 1);
     undo_.push_back({Undo::Kind::spawn, {}});
     status = "put back the drawn cloth";
   } else {
-    undo_.push_back({next.kind, world_->cloths(), world_->time()});
+    undo_.push_back({next.kind, world_->cloths().copy(), world_->time()});
     world_->restoreCloths(withMotionAfter(std::move(next.cloths), world_->cloths()));
     status = next.kind == Undo::Kind::cut ? "did the cut again" : "did the tear again";
   }

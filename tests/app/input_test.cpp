@@ -340,7 +340,7 @@ TEST(Session, RedoPutsBackACutWithTheMotionSinceAndADrawnClothAsItWas) {
   const std::vector<sim::Vec3> atUndo = session.world().cloths()[0].state.position;
   ASSERT_TRUE(session.undo());
   // Carry the whole cloth 10 cm along x, then redo: the cut comes back where the cloth is now.
-  std::vector<sim::Cloth> moved = session.world().cloths();
+  std::vector<sim::Cloth> moved = session.world().cloths().copy();
   for (sim::Vec3& x : moved[0].state.position) x.x += 0.1;
   for (sim::Vec3& x : moved[0].state.previousPosition) x.x += 0.1;
   session.world().restoreCloths(std::move(moved));
@@ -397,7 +397,7 @@ TEST(Session, RedoOfACutAcrossAnEarlierCutPutsEachCopyBesideItsOwnParticle) {
   ASSERT_TRUE(hand.up(1));
   ASSERT_EQ(session.world().cloths()[0].pieceCount, 2u);
   const auto carryFarHalf = [&](double dx) {
-    std::vector<sim::Cloth> cloths = session.world().cloths();
+    std::vector<sim::Cloth> cloths = session.world().cloths().copy();
     sim::Cloth& cloth = cloths[0];
     const std::vector<std::uint32_t> piece = cloth.piece;
     for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
@@ -534,15 +534,15 @@ TEST(Session, AnotherModelRestartsTheSceneWithThatModelsMaterials) {
   for (int step = 0; step < 2; ++step) ASSERT_EQ(session.step(), sim::StepStatus::ok) << session.status;
   ASSERT_FALSE(session.setModel(sim::Model::position, sim::Integrator::rk4));
   EXPECT_EQ(session.world().settings().solver.integrator, sim::Integrator::verlet);
-  EXPECT_EQ(session.world().settings().cloths[0].material(sim::ConstraintKind::stretch).stiffness, 1.0);
+  EXPECT_EQ(session.world().cloths()[0].settings.material(sim::ConstraintKind::stretch).stiffness, 1.0);
 }
 
 TEST(Session, AFabricRestartsEverySheetInPhysicalUnitsAndBackAsTheSceneSays) {
   Session session("desk");
-  const double seedMass = session.world().settings().cloths[0].mass;
+  const double seedMass = session.world().cloths()[0].settings.mass;
   ASSERT_FALSE(session.setFabric(std::string("denim"))) << session.status;
   EXPECT_EQ(session.fabric(), "denim");
-  const sim::ClothSettings& cloth = session.world().settings().cloths[0];
+  const sim::ClothSettings& cloth = session.world().cloths()[0].settings;
   ASSERT_TRUE(cloth.fabric);
   EXPECT_EQ(cloth.fabric->arealDensity, 0.324);
   EXPECT_EQ(cloth.fabric->bendingRigidity, 6.4e-5);
@@ -569,8 +569,8 @@ TEST(Session, AFabricRestartsEverySheetInPhysicalUnitsAndBackAsTheSceneSays) {
   EXPECT_EQ(session.fabric(), "denim");  // refused: nothing changed
   ASSERT_FALSE(session.setFabric(std::nullopt)) << session.status;
   EXPECT_TRUE(session.fabric().empty());
-  EXPECT_FALSE(session.world().settings().cloths[0].fabric);
-  EXPECT_EQ(session.world().settings().cloths[0].mass, seedMass);
+  EXPECT_FALSE(session.world().cloths()[0].settings.fabric);
+  EXPECT_EQ(session.world().cloths()[0].settings.mass, seedMass);
 }
 
 TEST(Session, AFabricTakesTheForceModelToThePositionModelAndRefusesASceneWithoutASheet) {
@@ -578,7 +578,7 @@ TEST(Session, AFabricTakesTheForceModelToThePositionModelAndRefusesASceneWithout
   ASSERT_FALSE(session.setModel(sim::Model::force, sim::Integrator::rk4)) << session.status;
   ASSERT_FALSE(session.setFabric(std::string("silk"))) << session.status;
   EXPECT_EQ(session.world().settings().solver.model, sim::Model::position);
-  EXPECT_TRUE(session.world().settings().cloths[0].fabric);
+  EXPECT_TRUE(session.world().cloths()[0].settings.fabric);
   Session chain("chain");
   const std::optional<std::string> refused = chain.setFabric(std::string("silk"));
   ASSERT_TRUE(refused);
@@ -606,7 +606,7 @@ TEST(Session, FramingLeavesThePanelsPartOfTheWindowAndFFramesTheClothWhereverItI
   EXPECT_LT(right, 0.7);                          // clear of the panel
   EXPECT_NEAR((left + right) / 2.0, 0.35, 0.05);  // in the middle of what is left
   // Carry the cloth off to one side and look elsewhere: F brings it back into view.
-  std::vector<sim::Cloth> moved = session.world().cloths();
+  std::vector<sim::Cloth> moved = session.world().cloths().copy();
   for (sim::Vec3& x : moved[0].state.position) x += sim::Vec3{3.0, 0.0, -2.0};
   for (sim::Vec3& x : moved[0].state.previousPosition) x += sim::Vec3{3.0, 0.0, -2.0};
   session.world().restoreCloths(std::move(moved));

@@ -899,7 +899,7 @@ TEST(Cutting, ASwipeThatStopsInsideLeavesASlitNotTwoPieces) {
 TEST(Cloths, CanBeAddedAndRemovedWhileTheWorldRuns) {
   World world(flatSheet(5, Vec3{0.0, -9.81, 0.0}));
   world.run(3);
-  ClothSettings extra = world.settings().cloths[0];
+  ClothSettings extra = world.cloths()[0].settings;
   extra.lattice.origin = Vec3{0.0, 1.0, 0.0};
   const std::uint64_t version = world.topologyVersion();
   EXPECT_EQ(world.addCloth(extra), 1);
@@ -954,7 +954,7 @@ TEST(Restore, PutsBackPositionsAndVelocitiesAndStillPins) {
     world.moveFinger(1, Vec3{0.0, 0.02 * step, 0.0});
     world.step();
   }
-  const std::vector<Cloth> taken = world.cloths();  // the pin is moving in the finger now
+  const std::vector<Cloth> taken = world.cloths().copy();  // the pin is moving in the finger now
   const Vec3 pinAt = taken[0].state.position[0];
   World other(flatSheet(5));
   other.restoreCloths(taken);

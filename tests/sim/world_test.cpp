@@ -129,7 +129,7 @@ TEST(Pipeline, TheSolverIsPlannedWhenTheWorldChangesNotWhileItSteps) {
   tuned.solver.stretchSolver = StretchSolver::lines;
   world.tune(tuned);
   stepAndCheck("the fast sweep");
-  const std::vector<Cloth> before = world.cloths();
+  const std::vector<Cloth> before = world.cloths().copy();
   const std::uint64_t uncut = world.topologyVersion();
   EXPECT_EQ(world.cut(Vec3{0.0, 2.0, -0.6}, Vec3{0.0, 2.0, 0.6}, Vec3{0.0, -4.0, 0.0}), 1);
   EXPECT_NE(world.topologyVersion(), uncut);
@@ -243,7 +243,7 @@ TEST(Guard, NamesTheFirstParticleThatRunsAwayWhereverItIs) {
   for (const std::vector<ParticleIndex>& runaways :
        std::vector<std::vector<ParticleIndex>>{{700}, {255}, {256}, {899}, {611, 300}, {3, 899}}) {
     World world(settings);
-    std::vector<Cloth> cloths = world.cloths();
+    std::vector<Cloth> cloths = world.cloths().copy();
     ParticleState& s = cloths[0].state;
     for (ParticleIndex i : runaways) s.previousPosition[i] = s.position[i] - Vec3{0.0, 2.0 * kRunawayDistance, 0.0};
     world.restoreCloths(cloths);
@@ -278,7 +278,7 @@ TEST(Guard, PutsBackEveryPositionAsItWasBeforeTheBadStepBitForBitAtRest) {
       ASSERT_TRUE(world.moveFinger(1, world.cloths()[0].state.position[210] + Vec3{0.0, 0.05, 0.0}));
     }
     ASSERT_EQ(world.step(), StepStatus::ok);
-    std::vector<Cloth> cloths = world.cloths();
+    std::vector<Cloth> cloths = world.cloths().copy();
     cloths[0].state.previousPosition.back() -= Vec3{0.0, 0.0, 1e6 * kRunawayDistance};
     world.restoreCloths(cloths);
     if (finger) {  // another way than before: the finger sets what the particles held were moving at
@@ -308,10 +308,10 @@ TEST(Guard, CopiesWhereAStageAfterIntegrationWritesThePreviousPositions) {
     World world(settings);
     ASSERT_EQ(world.hasStage(Stage::dampConstraints), copies);
     world.run(10);
-    std::vector<Cloth> cloths = world.cloths();
+    std::vector<Cloth> cloths = world.cloths().copy();
     cloths.back().state.previousPosition.back() -= Vec3{0.0, 0.0, 1e6 * kRunawayDistance};
     world.restoreCloths(cloths);
-    const std::vector<Cloth> before = world.cloths();
+    const std::vector<Cloth> before = world.cloths().copy();
     ASSERT_EQ(world.step(), StepStatus::diverged);
     EXPECT_EQ(world.memoryUse().guard > 0, copies);
     for (std::size_t c = 0; c < before.size(); ++c) {

@@ -189,7 +189,7 @@ CantileverResult drawnCantilever(const CantileverSpec& spec, const std::chrono::
   cloth.fabric = spec.fabric;
   settings.cloths.push_back(cloth);
   sim::World world(settings);
-  std::vector<sim::Cloth> cloths = world.cloths();
+  std::vector<sim::Cloth> cloths = world.cloths().copy();
   sim::ParticleState& state = cloths[0].state;
   const sim::Vec3 tipCorners[2] = {at(spec.overhang, 0.0), at(spec.overhang, spec.width)};
   std::size_t tip[2] = {0, 0};

@@ -14,6 +14,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "cloth_work.hpp"
 #include "collision/contacts.hpp"
 #include "collision/self_contact.hpp"
 #include "invariant.hpp"
@@ -257,7 +258,7 @@ World::World(WorldSettings settings)
   validate(settings_);
   for (std::size_t c = 0; c < settings_.cloths.size(); ++c) {
     try {
-      cloths_.push_back(makeCloth(settings_.cloths[c], settings_.solver.model));
+      records_.emplace_back(makeCloth(settings_.cloths[c], settings_.solver.model));
     } catch (const std::invalid_argument& error) {
       // "cloths.2: ...", or "cloths.2.grid.width: ..." where the message names a key of the cloth.
       const std::string what = error.what();
@@ -265,9 +266,8 @@ World::World(WorldSettings settings)
     }
   }
   require(particleCount() <= static_cast<std::size_t>(kMaxParticles), "too many particles");
-  scratch_.resize(cloths_.size());
-  held_.resize(cloths_.size());
-  for (std::size_t c = 0; c < cloths_.size(); ++c) buildTethers(c);
+  settings_.cloths.clear();  // each cloth keeps its own, in its record
+  for (std::size_t c = 0; c < records_.size(); ++c) buildTethers(c);
   for (const ColliderSettings& collider : settings_.colliders) colliders_.emplace_back(collider);
   buildPipeline();
   planAll();
@@ -275,17 +275,17 @@ World::World(WorldSettings settings)
 
 void World::buildTethers(std::size_t c) {
   if (!settings_.solver.tethers || settings_.solver.model != Model::position) return;
-  const std::vector<SolverScratch::Tethers::Tether> tethers = nearestPinTethers(cloths_[c]);
-  scratch_[c].tethers.assign(tethers);
+  const std::vector<SolverScratch::Tethers::Tether> tethers = nearestPinTethers(records_[c].cloth);
+  records_[c].work->solver.tethers.assign(tethers);
 }
 
 void World::buildPipeline() {
   const Model model = settings_.solver.model;
   bool anyTriangles = false, anyProjected = false, anyDamped = false;
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    const Cloth& cloth = cloths_[c];
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    const Cloth& cloth = records_[c].cloth;
     anyTriangles = anyTriangles || !cloth.rest.triangles.empty();
-    anyProjected = anyProjected || !scratch_[c].tethers.empty();
+    anyProjected = anyProjected || !records_[c].work->solver.tethers.empty();
     for (ConstraintKind kind : kConstraintKinds) {
       if (cloth.rest.of(kind).empty()) continue;
       anyProjected = anyProjected || cloth.settings.material(kind).stiffness > 0.0;
@@ -337,7 +337,7 @@ void World::buildPipeline() {
     if (anyColliders) add(Stage::collideForces, true);
   }
   add(Stage::guard, false);
-  if (settings_.tearing.enabled && !cloths_.empty()) add(Stage::tear, false);
+  if (settings_.tearing.enabled && !records_.empty()) add(Stage::tear, false);
   // The guard goes back to the positions before the step, at rest: no copy where one substep of the
   // position model leaves them in the previous positions (its integration sets x_prev = x and no
   // stage after it writes x_prev); else a copy, made by that integration as it reads them where
@@ -366,10 +366,10 @@ void World::buildPipeline() {
     // Wind pressure's per-particle accelerations exist exactly while its stage does (tuning can
     // switch it on or off): the integrator adds them whenever the array is there.
     const bool wind = hasStage(Stage::windPressure);
-    for (std::size_t c = 0; c < cloths_.size() && c < scratch_.size(); ++c) {
-      std::vector<Vec3>& acceleration = scratch_[c].acceleration;
+    for (std::size_t c = 0; c < records_.size(); ++c) {
+      std::vector<Vec3>& acceleration = records_[c].work->solver.acceleration;
       if (wind) {
-        acceleration.resize(cloths_[c].state.position.size(), Vec3{0.0});
+        acceleration.resize(records_[c].cloth.state.position.size(), Vec3{0.0});
       } else {
         acceleration.clear();
       }
@@ -378,11 +378,11 @@ void World::buildPipeline() {
 }
 
 void World::plan(std::size_t c) {
-  SolverScratch& scratch = scratch_[c];
+  SolverScratch& scratch = records_[c].work->solver;
   if (scratch.planVersion == topologyVersion_) return;
   if (settings_.solver.lines()) {
     // The fast sweep's batches: the constraints are put in batch order, once per topology.
-    Cloth& cloth = cloths_[c];
+    Cloth& cloth = records_[c].cloth;
     // A torn cloth's constraints each name their recipe: the names move with them.
     // The stretch constraints have none: the lines put them in line order and solve them (a loose
     // one one by one).
@@ -407,7 +407,7 @@ void World::setThreads(int threads) {
   require(threads >= 1 && threads <= kMaxThreads, "threads must be 1 to 64");
   if (threads == workers_->threads()) return;
   workers_ = std::make_unique<Workers>(threads);
-  for (SolverScratch& scratch : scratch_) scratch.planVersion = 0;  // line slices are per thread
+  for (ClothRecord& record : records_) record.work->solver.planVersion = 0;  // line slices are per thread
   planAll();
 }
 
@@ -428,7 +428,8 @@ std::size_t bytes(const std::array<std::vector<T>, N>& arrays) {
 
 MemoryUse World::memoryUse() const {
   MemoryUse m;
-  for (const Cloth& cloth : cloths_) {
+  for (const ClothRecord& record : records_) {
+    const Cloth& cloth = record.cloth;
     m.rest += bytes(cloth.rest.restOffsets) + bytes(cloth.rest.triangles);
     m.constraints += bytes(cloth.rest.constraints) + bytes(cloth.rest.bending);
     const ParticleState& s = cloth.state;
@@ -439,7 +440,8 @@ MemoryUse World::memoryUse() const {
     m.topology += bytes(t.neighbour) + bytes(t.triangleArea) + bytes(t.templates) + bytes(t.source) +
                   bytes(t.restFrames) + bytes(cloth.piece);
   }
-  for (const SolverScratch& s : scratch_) {
+  for (const ClothRecord& record : records_) {
+    const SolverScratch& s = record.work->solver;
     m.solver += bytes(s.acceleration) + bytes(s.trialPosition) + bytes(s.trialVelocity) + bytes(s.sumPosition) +
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
                 bytes(s.contactDepth) + bytes(s.contactRub) + bytes(s.layerContacts) + bytes(s.lambda) +
@@ -452,8 +454,10 @@ MemoryUse World::memoryUse() const {
       m.lines += bytes(f.start) + bytes(f.lambda) + bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
     }
   }
-  for (const std::vector<Vec3>& good : lastGood_) m.guard += bytes(good);
-  for (const std::vector<std::uint8_t>& held : held_) m.solver += bytes(held);
+  for (const ClothRecord& record : records_) {
+    m.guard += bytes(record.work->lastGood);
+    m.solver += bytes(record.work->held);
+  }
   const SelfCollisionScratch& h = *selfCollisionScratch_;
   m.solver += bytes(h.owner) + bytes(h.cell) + bytes(h.start) + bytes(h.fill) + bytes(h.entries);
   for (const auto& pairs : h.pairs) m.solver += bytes(pairs);
@@ -465,17 +469,31 @@ std::size_t World::memoryBytes() const { return memoryUse().total(); }
 
 std::size_t World::tetherCount() const {
   std::size_t n = 0;
-  for (const SolverScratch& s : scratch_) n += s.tethers.size();
+  for (const ClothRecord& record : records_) n += record.work->solver.tethers.size();
   return n;
 }
 
 std::int64_t World::extraLineSteps() const {
   std::int64_t n = 0;
-  for (const SolverScratch& s : scratch_) n += s.extraLineSteps;
+  for (const ClothRecord& record : records_) n += record.work->solver.extraLineSteps;
   return n;
 }
 
 SelfContactStats World::selfContactStats() const { return selfContact_ ? selfContact_->stats() : SelfContactStats{}; }
+
+ClothRecord::ClothRecord(Cloth c) : cloth(std::move(c)), work(std::make_unique<ClothWork>()) {}
+ClothRecord::ClothRecord(ClothRecord&&) noexcept = default;
+ClothRecord& ClothRecord::operator=(ClothRecord&&) noexcept = default;
+ClothRecord::~ClothRecord() = default;
+
+std::vector<Cloth> ClothList::copy() const {
+  std::vector<Cloth> cloths;
+  cloths.reserve(records_->size());
+  for (const ClothRecord& record : *records_) cloths.push_back(record.cloth);
+  return cloths;
+}
+
+bool World::isHeld(std::size_t cloth, std::size_t particle) const { return records_[cloth].work->isHeld(particle); }
 
 World::~World() = default;
 World::World(World&&) noexcept = default;
@@ -491,7 +509,8 @@ bool World::hasStage(Stage stage) const {
 Real World::stableForceSubstep() const {
   if (settings_.solver.model != Model::force) return std::numeric_limits<Real>::infinity();
   Real fastest = 0.0;  // omega + decay rate, 1/s
-  for (const Cloth& cloth : cloths_) {
+  for (const ClothRecord& record : records_) {
+    const Cloth& cloth = record.cloth;
     const ParticleState& s = cloth.state;
     std::vector<Real> stiffness(s.position.size(), 0.0), damping(s.position.size(), 0.0);
     for (ConstraintKind kind : kConstraintKinds) {
@@ -515,7 +534,7 @@ Real World::stableForceSubstep() const {
 }
 
 Vec3 World::velocity(int cloth, ParticleIndex particle) const {
-  const ParticleState& s = cloths_.at(static_cast<std::size_t>(cloth)).state;
+  const ParticleState& s = records_.at(static_cast<std::size_t>(cloth)).cloth.state;
   if (!s.velocity.empty()) return s.velocity.at(particle);
   return (s.position.at(particle) - s.previousPosition.at(particle)) / static_cast<Real>(substepDt());
 }
@@ -523,15 +542,15 @@ Vec3 World::velocity(int cloth, ParticleIndex particle) const {
 void World::startHistory(std::size_t c) {
   const Real h = static_cast<Real>(substepDt());
   if (settings_.solver.model == Model::position) {
-    position::startHistory(cloths_[c], settings_.gravity + settings_.air.drag * settings_.air.velocity,
+    position::startHistory(records_[c].cloth, settings_.gravity + settings_.air.drag * settings_.air.velocity,
                            settings_.solver.damping + settings_.air.drag, h);
   } else {
-    force::startHistory(cloths_[c], settings_, h, scratch_[c]);
+    force::startHistory(records_[c].cloth, settings_, h, records_[c].work->solver);
   }
 }
 
 void World::startHistory() {
-  for (std::size_t c = 0; c < cloths_.size(); ++c) startHistory(c);
+  for (std::size_t c = 0; c < records_.size(); ++c) startHistory(c);
   historyStarted_ = true;
 }
 
@@ -568,54 +587,60 @@ void World::positionSubstep(Real h) {
   const position::Substep substep = position::makeSubstep(settings_, h);
   timed(Stage::fingers, [&](PartClock&) { moveFingers(substep.h); });
   timed(Stage::windPressure, [&](PartClock&) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c)
-      position::accumulateWindPressure(cloths_[c], settings_.air, substep.h, scratch_[c].acceleration);
+    for (std::size_t c = 0; c < records_.size(); ++c)
+      position::accumulateWindPressure(records_[c].cloth, settings_.air, substep.h,
+                                       records_[c].work->solver.acceleration);
   });
   timed(Stage::verletIntegrate, [&](PartClock&) {
     const bool keep = guardCopy_ == GuardCopy::integration && substep_ == 0;
-    for (std::size_t c = 0; c < cloths_.size(); ++c) {
-      std::vector<Vec3>& acceleration = scratch_[c].acceleration;
-      position::integrate(cloths_[c], substep, acceleration.empty() ? nullptr : &acceleration, *workers_,
-                          keep ? lastGood_[c].data() : nullptr);
+    for (std::size_t c = 0; c < records_.size(); ++c) {
+      std::vector<Vec3>& acceleration = records_[c].work->solver.acceleration;
+      position::integrate(records_[c].cloth, substep, acceleration.empty() ? nullptr : &acceleration, *workers_,
+                          keep ? records_[c].work->lastGood.data() : nullptr);
     }
   });
-  timed(Stage::selfCollide,
-        [&](PartClock&) { contact::selfCollide(cloths_, settings_.selfCollision, *selfCollisionScratch_, *workers_); });
+  timed(Stage::selfCollide, [&](PartClock&) {
+    contact::selfCollide(records_, settings_.selfCollision, *selfCollisionScratch_, *workers_);
+  });
   timed(Stage::collide, [&](PartClock&) {
     moveColliders();
-    for (std::size_t c = 0; c < cloths_.size(); ++c) contact::detect(cloths_[c], colliders_, scratch_[c]);
+    for (std::size_t c = 0; c < records_.size(); ++c)
+      contact::detect(records_[c].cloth, colliders_, records_[c].work->solver);
   });
   timed(Stage::projectConstraints, [&](PartClock& parts) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) {
+    for (std::size_t c = 0; c < records_.size(); ++c) {
       // Planned when the world changed (planAll: a tear's or a cut's time includes it), never by the
       // sweeps' own stage. (Should a path have missed it, a build that does not check this plans
       // here, and the plan shows in the profile.)
-      DRAPE_INVARIANT(scratch_[c].planVersion == topologyVersion_, "planAll ran after every change a plan is made of");
-      if (scratch_[c].planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
-      position::projectConstraints(cloths_[c], settings_.solver, substep, scratch_[c], colliders_, *workers_, parts);
+      DRAPE_INVARIANT(records_[c].work->solver.planVersion == topologyVersion_,
+                      "planAll ran after every change a plan is made of");
+      if (records_[c].work->solver.planVersion != topologyVersion_) parts.time(Stage::plan, [&] { plan(c); });
+      position::projectConstraints(records_[c].cloth, settings_.solver, substep, records_[c].work->solver, colliders_,
+                                   *workers_, parts);
     }
   });
   timed(Stage::friction, [&](PartClock&) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) contact::friction(cloths_[c], colliders_, substep.h, scratch_[c]);
+    for (std::size_t c = 0; c < records_.size(); ++c)
+      contact::friction(records_[c].cloth, colliders_, substep.h, records_[c].work->solver);
   });
   timed(Stage::selfContact, [&](PartClock& parts) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
-    selfContact_->solve(cloths_, scratch_, settings_.selfCollision, topologyVersion_,
-                        settings_.solver.substeps - substep_, *workers_, &parts);
+    selfContact_->solve(records_, settings_.selfCollision, topologyVersion_, settings_.solver.substeps - substep_,
+                        *workers_, &parts);
     if (!colliders_.empty()) {
       parts.time(Stage::friction, [&] {
-        for (std::size_t c = 0; c < cloths_.size(); ++c)
-          contact::friction(cloths_[c], colliders_, substep.h, scratch_[c]);
+        for (std::size_t c = 0; c < records_.size(); ++c)
+          contact::friction(records_[c].cloth, colliders_, substep.h, records_[c].work->solver);
       });
     }
-    selfContact_->finish(cloths_, settings_.selfCollision, *workers_, &parts);
+    selfContact_->finish(records_, settings_.selfCollision, *workers_, &parts);
   });
   timed(Stage::clampTravel, [&](PartClock&) {
-    for (Cloth& cloth : cloths_)
-      contact::clampTravel(cloth, settings_.selfCollision.maxTravel * settings_.selfCollision.distance);
+    for (ClothRecord& record : records_)
+      contact::clampTravel(record.cloth, settings_.selfCollision.maxTravel * settings_.selfCollision.distance);
   });
   timed(Stage::dampConstraints, [&](PartClock&) {
-    for (Cloth& cloth : cloths_) position::dampConstraints(cloth);
+    for (ClothRecord& record : records_) position::dampConstraints(record.cloth);
   });
 }
 
@@ -624,12 +649,13 @@ void World::forceSubstep(Real h) {
   timed(Stage::fingers, [&](PartClock&) { moveFingers(h); });
   const Integrator integrator = settings_.solver.integrator;
   timed(integratorStage(integrator), [&](PartClock&) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) force::step(integrator, cloths_[c], settings_, h, scratch_[c]);
+    for (std::size_t c = 0; c < records_.size(); ++c)
+      force::step(integrator, records_[c].cloth, settings_, h, records_[c].work->solver);
   });
   timed(Stage::collideForces, [&](PartClock&) {
     moveColliders();
-    for (std::size_t c = 0; c < cloths_.size(); ++c)
-      contact::respondWithVelocities(cloths_[c], colliders_, h, scratch_[c]);
+    for (std::size_t c = 0; c < records_.size(); ++c)
+      contact::respondWithVelocities(records_[c].cloth, colliders_, h, records_[c].work->solver);
   });
 }
 
@@ -643,8 +669,8 @@ void World::moveColliders() {
 }
 
 std::optional<Divergence> World::findBadParticle() const {
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    const ParticleState& s = cloths_[c].state;
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    const ParticleState& s = records_[c].cloth.state;
     const auto bad = [&](std::size_t i) {
       const Vec3 x = s.position[i];
       return !finite(x) ||
@@ -694,10 +720,9 @@ StepStatus World::step() {
   if (divergence_) return StepStatus::diverged;
   if (!historyStarted_) startHistory();
   // The positions before the step, for the guard (where its copy is made: buildPipeline).
-  lastGood_.resize(cloths_.size());
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    std::vector<Vec3>& good = lastGood_[c];
-    const std::vector<Vec3>& x = cloths_[c].state.position;
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    std::vector<Vec3>& good = records_[c].work->lastGood;
+    const std::vector<Vec3>& x = records_[c].cloth.state.position;
     if (guardCopy_ == GuardCopy::none) {
       good = {};
       continue;
@@ -717,7 +742,7 @@ StepStatus World::step() {
     for (StageTiming& part : timing.parts) part.lastSeconds = 0.0;
   }
   // A step starts from its state alone: the layers' contacts its substeps hand on begin empty.
-  for (SolverScratch& scratch : scratch_) scratch.layerContacts.clear();
+  for (ClothRecord& record : records_) record.work->solver.layerContacts.clear();
   const Real h = static_cast<Real>(substepDt());
   for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
     substep_ = substep;
@@ -742,13 +767,13 @@ StepStatus World::step() {
   }
 
   if (divergence_) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) {
-      ParticleState& s = cloths_[c].state;
+    for (std::size_t c = 0; c < records_.size(); ++c) {
+      ParticleState& s = records_[c].cloth.state;
       if (guardCopy_ == GuardCopy::none) {
         s.position = s.previousPosition;
       } else {
-        s.position = lastGood_[c];
-        s.previousPosition = lastGood_[c];
+        s.position = records_[c].work->lastGood;
+        s.previousPosition = records_[c].work->lastGood;
       }
       std::fill(s.velocity.begin(), s.velocity.end(), Vec3{0.0});
     }
@@ -764,23 +789,23 @@ StepStatus World::step() {
 // What every step leaves as it found it: one record per cloth in each per-cloth array, each
 // particle's arrays as long as its cloth's positions, and the fingers' grips on particles that exist.
 void World::checkInvariants() const {
-  DRAPE_INVARIANT(scratch_.size() == cloths_.size() && held_.size() == cloths_.size(), "a record per cloth");
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    const ParticleState& s = cloths_[c].state;
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    const ParticleState& s = records_[c].cloth.state;
     const std::size_t n = s.position.size();
-    DRAPE_INVARIANT(n == cloths_[c].rest.particleCount(), "a particle's rest and state together");
+    DRAPE_INVARIANT(n == records_[c].cloth.rest.particleCount(), "a particle's rest and state together");
     DRAPE_INVARIANT(
         s.previousPosition.size() == n && s.inverseMass.size() == n && s.mass.size() == n && s.pinned.size() == n,
         "every particle array as long as the positions");
     DRAPE_INVARIANT(s.velocity.empty() || s.velocity.size() == n, "velocities for every particle or none");
-    DRAPE_INVARIANT(held_[c].empty() || held_[c].size() == n, "held flags for every particle or none");
-    DRAPE_INVARIANT(scratch_[c].acceleration.empty() || scratch_[c].acceleration.size() == n,
+    DRAPE_INVARIANT(records_[c].work->held.empty() || records_[c].work->held.size() == n,
+                    "held flags for every particle or none");
+    DRAPE_INVARIANT(records_[c].work->solver.acceleration.empty() || records_[c].work->solver.acceleration.size() == n,
                     "wind accelerations for every particle or none");
   }
   for (const Finger& finger : fingers_) {
     for (const FingerGrip& grip : finger.grips) {
       const auto c = static_cast<std::size_t>(grip.cloth);
-      DRAPE_INVARIANT(c < cloths_.size() && grip.particle < cloths_[c].state.position.size(),
+      DRAPE_INVARIANT(c < records_.size() && grip.particle < records_[c].cloth.state.position.size(),
                       "a finger holds particles that exist");
       DRAPE_INVARIANT(isHeld(c, grip.particle), "a particle a finger holds is marked held");
     }
@@ -811,15 +836,15 @@ Finger* World::findFinger(int id) {
 }
 
 void World::grab(Finger& finger, std::size_t c, ParticleIndex nearest) {
-  Cloth& cloth = cloths_[c];
+  Cloth& cloth = records_[c].cloth;
   ParticleState& s = cloth.state;
   const Real r2 = finger.radius * finger.radius;
   const std::uint32_t piece = cloth.pieceOf(nearest);
-  if (held_[c].empty()) held_[c].assign(s.position.size(), 0);
+  if (records_[c].work->held.empty()) records_[c].work->held.assign(s.position.size(), 0);
   for (std::size_t i = 0; i < s.position.size(); ++i) {
     const Vec3 offset = s.position[i] - finger.position;
-    if (held_[c][i] || cloth.pieceOf(i) != piece || glm::dot(offset, offset) > r2) continue;
-    held_[c][i] = 1;
+    if (records_[c].work->held[i] || cloth.pieceOf(i) != piece || glm::dot(offset, offset) > r2) continue;
+    records_[c].work->held[i] = 1;
     s.inverseMass[i] = 0.0;
     finger.grips.push_back({static_cast<int>(c), static_cast<ParticleIndex>(i), offset});
   }
@@ -837,8 +862,8 @@ std::optional<int> World::pressFinger(int id, Vec3 point, Real radius) {
   // The piece under the finger is the piece of the free particle nearest to it.
   Real best = radius * radius;
   std::optional<std::pair<std::size_t, ParticleIndex>> nearest;
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    const ParticleState& s = cloths_[c].state;
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    const ParticleState& s = records_[c].cloth.state;
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       const Vec3 d = s.position[i] - point;
       const Real d2 = glm::dot(d, d);
@@ -860,8 +885,8 @@ std::optional<Vec3> World::pressFingerAlongRay(int id, Vec3 origin, Vec3 directi
   }
   const Vec3 unit = glm::normalize(direction);
   std::optional<Real> first;
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    const ParticleState& s = cloths_[c].state;
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    const ParticleState& s = records_[c].cloth.state;
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       if (isHeld(c, i)) continue;
       const Vec3 d = s.position[i] - origin;
@@ -887,8 +912,8 @@ bool World::releaseFinger(int id) {
   Finger* f = findFinger(id);
   if (!f) return false;
   for (const FingerGrip& grip : f->grips) {
-    ParticleState& s = cloths_[static_cast<std::size_t>(grip.cloth)].state;
-    held_[static_cast<std::size_t>(grip.cloth)][grip.particle] = 0;
+    ParticleState& s = records_[static_cast<std::size_t>(grip.cloth)].cloth.state;
+    records_[static_cast<std::size_t>(grip.cloth)].work->held[grip.particle] = 0;
     if (s.pinned[grip.particle]) {
       // A pin the finger carried stays where it was put.
       s.previousPosition[grip.particle] = s.position[grip.particle];
@@ -909,7 +934,7 @@ std::optional<int> World::pinFinger(int id) {
   std::vector<std::size_t> changed;
   for (const FingerGrip& grip : f->grips) {
     const auto c = static_cast<std::size_t>(grip.cloth);
-    cloths_[c].state.pinned[grip.particle] = 1;
+    records_[c].cloth.state.pinned[grip.particle] = 1;
     if (std::find(changed.begin(), changed.end(), c) == changed.end()) changed.push_back(c);
   }
   const int pinned = static_cast<int>(f->grips.size());
@@ -923,8 +948,8 @@ std::optional<int> World::pinFinger(int id) {
 int World::unpin(Vec3 point, Real radius) {
   if (!finite(point) || !finite(radius) || !(radius > 0.0)) return 0;
   int freed = 0;
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    ParticleState& s = cloths_[c].state;
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    ParticleState& s = records_[c].cloth.state;
     bool changed = false;
     for (std::size_t i = 0; i < s.position.size(); ++i) {
       const Vec3 d = s.position[i] - point;
@@ -932,7 +957,7 @@ int World::unpin(Vec3 point, Real radius) {
       s.pinned[i] = 0;
       s.inverseMass[i] = 1.0 / s.mass[i];
       ++freed;
-      std::vector<ParticleIndex>& anchors = cloths_[c].tetherPins;
+      std::vector<ParticleIndex>& anchors = records_[c].cloth.tetherPins;
       const auto anchor = std::find(anchors.begin(), anchors.end(), static_cast<ParticleIndex>(i));
       if (anchor != anchors.end()) anchors.erase(anchor);  // for good: pinned again by hand it is anywhere
       changed = true;
@@ -951,7 +976,7 @@ void World::moveFingers(Real h) {
     const Vec3 start = f.position + path * from;
     const Vec3 travel = path * (to - from);
     for (const FingerGrip& grip : f.grips) {
-      ParticleState& s = cloths_[static_cast<std::size_t>(grip.cloth)].state;
+      ParticleState& s = records_[static_cast<std::size_t>(grip.cloth)].cloth.state;
       if (selfContactHolds_) {
         // Self-contact may have held the particle back where the finger would have driven it through
         // cloth (its fail-safe moves a held particle with the rest of an impact zone): it goes on from
@@ -979,16 +1004,16 @@ void World::moveFingers(Real h) {
 
 std::size_t World::particleCount() const {
   std::size_t n = 0;
-  for (const Cloth& cloth : cloths_) n += cloth.state.position.size();
+  for (const ClothRecord& record : records_) n += record.cloth.state.position.size();
   return n;
 }
 
 void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>& splits,
                                 const std::vector<ParticleInsert>& inserted) {
-  Cloth& cloth = cloths_[c];
+  Cloth& cloth = records_[c].cloth;
   const std::size_t n = cloth.state.position.size();
   cloth.stretchTension.clear();  // its links were split or re-pointed: the tension builds again
-  if (!held_[c].empty()) held_[c].resize(n, 0);
+  if (!records_[c].work->held.empty()) records_[c].work->held.resize(n, 0);
   // A particle a cut put between two particles one finger holds is held by it too, where it lies.
   for (const ParticleInsert& in : inserted) {
     if (!isHeld(c, in.a) || !isHeld(c, in.b)) continue;
@@ -1002,7 +1027,7 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
       if (!ga || !gb) continue;
       const Vec3 offset = glm::mix(ga->offset, gb->offset, in.s);
       f.grips.push_back({static_cast<int>(c), in.particle, offset});
-      held_[c][in.particle] = 1;
+      records_[c].work->held[in.particle] = 1;
       cloth.state.inverseMass[in.particle] = 0.0;
       break;
     }
@@ -1014,12 +1039,12 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
       for (std::size_t g = 0; g < f.grips.size(); ++g) {
         if (f.grips[g].cloth != static_cast<int>(c) || f.grips[g].particle != split.original) continue;
         f.grips.push_back({static_cast<int>(c), split.copy, f.grips[g].offset});
-        held_[c][split.copy] = 1;
+        records_[c].work->held[split.copy] = 1;
         break;
       }
     }
   }
-  SolverScratch& scratch = scratch_[c];
+  SolverScratch& scratch = records_[c].work->solver;
   grow(scratch.acceleration, n);
   grow(scratch.trialPosition, n);
   grow(scratch.trialVelocity, n);
@@ -1036,7 +1061,7 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
 
 void World::planAll() {
   if (!hasStage(Stage::projectConstraints)) return;
-  for (std::size_t c = 0; c < cloths_.size(); ++c) plan(c);
+  for (std::size_t c = 0; c < records_.size(); ++c) plan(c);
 }
 
 void World::tear() {
@@ -1064,23 +1089,23 @@ int World::changeTopology(
   const bool settle = hasStage(Stage::selfContact);
   std::vector<std::vector<Vec3>> before;
   if (settle) {
-    for (const Cloth& cloth : cloths_) before.push_back(cloth.state.position);
+    for (const ClothRecord& record : records_) before.push_back(record.cloth.state.position);
   }
   int opened = 0;
   std::vector<ParticleSplit> splits;
   std::vector<ParticleInsert> inserted;
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
+  for (std::size_t c = 0; c < records_.size(); ++c) {
     splits.clear();
     inserted.clear();
     const std::size_t budget =
         static_cast<std::size_t>(kMaxParticles) - std::min<std::size_t>(particleCount(), kMaxParticles);
-    if (!change(cloths_[c], budget, splits, inserted)) continue;
+    if (!change(records_[c].cloth, budget, splits, inserted)) continue;
     afterTopologyChange(c, splits, inserted);
     ++opened;
     if (!settle) continue;
     // New particles in the order they were made: each from particles made before it.
     std::vector<Vec3>& from = before[c];
-    const std::size_t n0 = from.size(), n = cloths_[c].state.position.size();
+    const std::size_t n0 = from.size(), n = records_[c].cloth.state.position.size();
     std::vector<std::int64_t> origin(n - n0, -1);  // index into inserted, or -2 - the copy's original
     for (std::size_t k = 0; k < inserted.size(); ++k) {
       if (inserted[k].particle >= n0) origin[inserted[k].particle - n0] = static_cast<std::int64_t>(k);
@@ -1098,18 +1123,18 @@ int World::changeTopology(
         from[p] = from[static_cast<std::size_t>(-2 - o)];
       } else {
         DRAPE_INVARIANT(false, "every new particle is a split's copy or an insert");
-        from[p] = cloths_[c].state.position[p];
+        from[p] = records_[c].cloth.state.position[p];
       }
     }
   }
   if (settle && opened > 0) {
     // (A cloth that did not change has as many particles as before.)
-    for (std::size_t c = 0; c < cloths_.size(); ++c) {
-      DRAPE_INVARIANT(before[c].size() == cloths_[c].state.position.size(),
+    for (std::size_t c = 0; c < records_.size(); ++c) {
+      DRAPE_INVARIANT(before[c].size() == records_[c].cloth.state.position.size(),
                       "a cloth that did not change kept its particles");
     }
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
-    selfContact_->settle(cloths_, before, settings_.selfCollision, topologyVersion_, *workers_);
+    selfContact_->settle(records_, before, settings_.selfCollision, topologyVersion_, *workers_);
   }
   planAll();
   return opened;
@@ -1125,7 +1150,7 @@ void World::setTearing(const TearSettings& tearing) {
 
 void World::tune(const WorldSettings& next) {
   WorldSettings candidate = next;
-  candidate.cloths = settings_.cloths;
+  candidate.cloths.clear();  // the cloths stay as they are (each with its own settings)
   require(
       candidate.solver.model == settings_.solver.model && candidate.solver.integrator == settings_.solver.integrator,
       "the model and the integrator cannot change while the world runs");
@@ -1144,8 +1169,8 @@ void World::tune(const WorldSettings& next) {
   const Real hAfter = static_cast<Real>(substepDt());
   if (historyStarted_ && hAfter != hBefore) {
     // Verlet keeps velocity as x - x_prev over one substep: rescale it to the new substep.
-    for (Cloth& cloth : cloths_) {
-      ParticleState& s = cloth.state;
+    for (ClothRecord& record : records_) {
+      ParticleState& s = record.cloth.state;
       for (std::size_t i = 0; i < s.position.size(); ++i) {
         s.previousPosition[i] = s.position[i] - (s.position[i] - s.previousPosition[i]) * (hAfter / hBefore);
       }
@@ -1155,10 +1180,10 @@ void World::tune(const WorldSettings& next) {
     colliders_[i] = Collider(settings_.colliders[i]);
     colliders_[i].setTime(time());
   }
-  for (SolverScratch& scratch : scratch_) scratch.planVersion = 0;  // lines may have been switched
+  for (ClothRecord& record : records_) record.work->solver.planVersion = 0;  // lines may have been switched
   if (tethersChanged) {
-    for (std::size_t c = 0; c < cloths_.size(); ++c) {
-      scratch_[c].tethers.clear();
+    for (std::size_t c = 0; c < records_.size(); ++c) {
+      records_[c].work->solver.tethers.clear();
       buildTethers(c);
     }
   }
@@ -1173,11 +1198,8 @@ int World::addCloth(const ClothSettings& settings) {
   Cloth cloth = makeCloth(settings, settings_.solver.model);
   require(particleCount() + cloth.state.position.size() <= static_cast<std::size_t>(kMaxParticles),
           "too many particles");
-  cloths_.push_back(std::move(cloth));
-  settings_.cloths.push_back(settings);
-  const std::size_t c = cloths_.size() - 1;
-  scratch_.emplace_back();
-  held_.emplace_back();
+  records_.emplace_back(std::move(cloth));
+  const std::size_t c = records_.size() - 1;
   buildTethers(c);
   buildPipeline();
   if (historyStarted_) {
@@ -1227,16 +1249,12 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   }
   require(particles <= static_cast<std::size_t>(kMaxParticles), "too many particles");
   while (!fingers_.empty()) releaseFinger(fingers_.front().id);
-  cloths_ = std::move(cloths);
-  settings_.cloths.clear();
-  scratch_.assign(cloths_.size(), SolverScratch{});
-  held_.clear();
-  lastGood_.clear();
-  for (std::size_t c = 0; c < cloths_.size(); ++c) {
-    Cloth& cloth = cloths_[c];
+  records_.clear();
+  for (Cloth& cloth : cloths) records_.emplace_back(std::move(cloth));
+  for (std::size_t c = 0; c < records_.size(); ++c) {
+    Cloth& cloth = records_[c].cloth;
     cloth.settings = withFabricMaterials(cloth.settings);
     if (cloth.settings.fabric) cloth.rest.bending = buildBendStencils(cloth.rest);  // derived from the rest shape
-    settings_.cloths.push_back(cloth.settings);
     ParticleState& s = cloth.state;
     // Inverse masses follow from masses and pins (no finger holds anything now); a pin stands still
     // (it may have been caught moving in a finger when the copy was taken).
@@ -1248,10 +1266,9 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
     }
     cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
     sortUnique(cloth.tetherPins);  // as makeCloth keeps them
-    held_.emplace_back();
     buildTethers(c);
     if (settings_.solver.model == Model::force)
-      force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), scratch_[c]);
+      force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), records_[c].work->solver);
   }
   buildPipeline();
   // The cloths come with their own history (x_prev, velocities): the next step must not restart it.
@@ -1261,18 +1278,14 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
 }
 
 void World::removeCloth(int index) {
-  if (index < 0 || static_cast<std::size_t>(index) >= cloths_.size()) return;
+  if (index < 0 || static_cast<std::size_t>(index) >= records_.size()) return;
   for (Finger& f : fingers_) {
     std::erase_if(f.grips, [&](const FingerGrip& g) { return g.cloth == index; });
     for (FingerGrip& g : f.grips) {
       if (g.cloth > index) --g.cloth;
     }
   }
-  cloths_.erase(cloths_.begin() + index);
-  settings_.cloths.erase(settings_.cloths.begin() + index);
-  scratch_.erase(scratch_.begin() + index);
-  held_.erase(held_.begin() + index);
-  lastGood_.clear();
+  records_.erase(records_.begin() + index);
   buildPipeline();
   topologyVersion_ = nextTopologyVersion();
   planAll();

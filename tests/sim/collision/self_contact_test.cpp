@@ -31,6 +31,14 @@ ClothSettings flatSheet(int n, Real size, Vec3 origin) {
   return cloth;
 }
 
+// The cloths in records, each with fresh working arrays, as the world keeps them: for calling
+// self-contact directly.
+std::vector<ClothRecord> recordsOf(const std::vector<Cloth>& cloths) {
+  std::vector<ClothRecord> records;
+  for (const Cloth& cloth : cloths) records.emplace_back(cloth);
+  return records;
+}
+
 WorldSettings withSelfContact(WorldSettings settings) {
   settings.selfCollision.enabled = true;
   settings.selfCollision.method = SelfContactMethod::triangles;
@@ -284,7 +292,7 @@ TEST(SelfContact, AFoldThrownThroughItselfAtItsCreaseStaysOnItsSide) {
     cloth.material(ConstraintKind::bend).stiffness = 0.0;
     settings.cloths.push_back(cloth);
     World world(withSelfContact(settings));
-    std::vector<Cloth> cloths = world.cloths();
+    std::vector<Cloth> cloths = world.cloths().copy();
     const std::vector<glm::uvec3> triangles = cloths[0].rest.triangles;
     ASSERT_EQ(triangles.size(), 2u);
     // The shared edge ab; c of the first triangle, d of the second.
@@ -338,7 +346,7 @@ TEST(SelfContact, AParticleFlungFarAwayCostsTheBroadPhaseNoMoreThanTheCloth) {
   WorldSettings settings = withSelfContact({});
   settings.cloths.push_back(flatSheet(8, 0.4, {-0.2, 0.3, -0.2}));
   World world(settings);
-  std::vector<Cloth> cloths = world.cloths();
+  std::vector<Cloth> cloths = world.cloths().copy();
   cloths[0].state.position[27].y = 1.9e13;
   world.restoreCloths(std::move(cloths));
   for (int i = 0; i < 2; ++i) world.step();  // ok or diverged
@@ -369,7 +377,7 @@ TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
   WorldSettings settings = withSelfContact({});
   settings.cloths.push_back(flatSheet(9, 0.2, {-0.1, 0.0, -0.1}));
   settings.cloths.push_back(flatSheet(7, 0.15, {-0.08, 0.01, -0.06}));
-  std::vector<Cloth> cloths = World(settings).cloths();
+  std::vector<Cloth> cloths = World(settings).cloths().copy();
   std::mt19937 random(7);
   std::uniform_real_distribution<Real> off(-0.03, 0.03), motion(-0.01, 0.01);
   for (Cloth& cloth : cloths) {
@@ -394,11 +402,10 @@ TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
   const std::vector<std::pair<std::uint32_t, std::uint32_t>> edges(edgeSet.begin(), edgeSet.end());
 
   const auto listed = [&](int threads) {
-    std::vector<Cloth> copy = cloths;
-    std::vector<SolverScratch> scratch(copy.size());
+    std::vector<ClothRecord> copy = recordsOf(cloths);
     Workers workers(threads);
     contact::SelfContact contact;
-    contact.solve(copy, scratch, settings.selfCollision, 1, 1, workers);
+    contact.solve(copy, settings.selfCollision, 1, 1, workers);
     std::vector<std::tuple<bool, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> pairs;
     for (const contact::SelfContact::Pair& p : contact.pairs()) {
       const std::array<std::uint32_t, 4> v = contact.corners(p);
@@ -502,27 +509,28 @@ TEST(SelfContact, APairCalledFarIsFartherThanTheDistanceThroughTheSubstep) {
   WorldSettings settings = withSelfContact({});
   settings.cloths.push_back(flatSheet(9, 0.2, {-0.1, 0.0, -0.1}));
   settings.cloths.push_back(flatSheet(7, 0.15, {-0.07, 0.008, -0.07}));
-  std::vector<Cloth> cloths = World(settings).cloths();
-  std::vector<SolverScratch> scratch(cloths.size());
+  std::vector<ClothRecord> records = recordsOf(World(settings).cloths().copy());
   Workers workers(2);
   contact::SelfContact contact;
   std::mt19937 random(11);
   std::uniform_real_distribution<Real> shake(-0.001, 0.001);
   int far = 0, substeps = 0, close = 0;
   for (; substeps < 24; ++substeps) {
-    for (Cloth& cloth : cloths) {
-      const Real sink = &cloth == &cloths[1] ? -0.0002 : 0.0;
+    for (ClothRecord& record : records) {
+      Cloth& cloth = record.cloth;
+      const Real sink = &record == &records[1] ? -0.0002 : 0.0;
       for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
         cloth.state.previousPosition[i] = cloth.state.position[i];
         cloth.state.position[i] += Vec3(shake(random), sink + shake(random), shake(random));
       }
     }
     std::vector<Vec3> x0, x;
-    for (const Cloth& cloth : cloths) {
-      x0.insert(x0.end(), cloth.state.previousPosition.begin(), cloth.state.previousPosition.end());
-      x.insert(x.end(), cloth.state.position.begin(), cloth.state.position.end());
+    for (const ClothRecord& record : records) {
+      const ParticleState& s = record.cloth.state;
+      x0.insert(x0.end(), s.previousPosition.begin(), s.previousPosition.end());
+      x.insert(x.end(), s.position.begin(), s.position.end());
     }
-    contact.solve(cloths, scratch, settings.selfCollision, 1, 4, workers);
+    contact.solve(records, settings.selfCollision, 1, 4, workers);
     for (const contact::SelfContact::Pair& p : contact.pairs()) {
       if (p.contact != contact::SelfContact::kFar) continue;
       ++far;
@@ -535,7 +543,7 @@ TEST(SelfContact, APairCalledFarIsFartherThanTheDistanceThroughTheSubstep) {
         ASSERT_GT(nearest, kDistance) << "substep " << substeps << ": a far pair " << nearest << " m apart";
       }
     }
-    contact.finish(cloths, settings.selfCollision, workers);
+    contact.finish(records, settings.selfCollision, workers);
   }
   // The pairs served several substeps (what they carry was used), and the sheets came within reach.
   EXPECT_LT(contact.stats().searches, substeps / 2);
@@ -554,7 +562,7 @@ TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
   WorldSettings settings = withSelfContact({});
   settings.cloths.push_back(flatSheet(9, 0.2, {-0.1, 0.0, -0.1}));
   settings.cloths.push_back(flatSheet(7, 0.15, {-0.07, 0.03, -0.07}));
-  const std::vector<Cloth> cloths = World(settings).cloths();
+  const std::vector<Cloth> cloths = World(settings).cloths().copy();
   using Listed = std::set<std::tuple<bool, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>>;
   const auto listed = [](const contact::SelfContact& contact) {
     Listed pairs;
@@ -565,14 +573,13 @@ TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
     return pairs;
   };
   const auto check = [&](const std::vector<std::size_t>& dropped, std::int64_t searches, std::int64_t refreshes) {
-    std::vector<Cloth> moved = cloths;
-    for (Cloth& cloth : moved) cloth.state.previousPosition = cloth.state.position;
-    std::vector<SolverScratch> scratch(moved.size());
+    std::vector<ClothRecord> moved = recordsOf(cloths);
+    for (ClothRecord& record : moved) record.cloth.state.previousPosition = record.cloth.state.position;
     Workers workers(1);
     contact::SelfContact contact;
-    contact.solve(moved, scratch, settings.selfCollision, 1, 1, workers);
+    contact.solve(moved, settings.selfCollision, 1, 1, workers);
     const std::size_t before = contact.pairs().size();
-    for (const std::size_t i : dropped) moved[1].state.position[i].y = 0.007;
+    for (const std::size_t i : dropped) moved[1].cloth.state.position[i].y = 0.007;
     contact.finish(moved, settings.selfCollision, workers);
     EXPECT_EQ(contact.stats().searches, searches);
     EXPECT_EQ(contact.stats().refreshes, refreshes);
@@ -581,7 +588,7 @@ TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
     EXPECT_GT(after.size(), before);
     // A search from where the substep began to where the particles are now.
     contact::SelfContact fresh;
-    fresh.solve(moved, scratch, settings.selfCollision, 1, 1, workers);
+    fresh.solve(moved, settings.selfCollision, 1, 1, workers);
     EXPECT_EQ(after, listed(fresh));
   };
   check({24}, 1, 1);  // the middle of the upper sheet: one particle of 130, a refresh
@@ -601,16 +608,15 @@ TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
 TEST(SelfContact, ATriangleStretchedTenfoldButShorterThanItsClothStillTakesPart) {
   WorldSettings settings = withSelfContact({});
   settings.cloths.push_back(flatSheet(21, 0.2, {-0.1, 0.0, -0.1}));
-  const std::vector<Cloth> cloths = World(settings).cloths();
+  const std::vector<Cloth> cloths = World(settings).cloths().copy();
   const auto pairsWithCorner = [&](Real lift) {
-    std::vector<Cloth> copy = cloths;
-    ParticleState& s = copy[0].state;
+    std::vector<ClothRecord> copy = recordsOf(cloths);
+    ParticleState& s = copy[0].cloth.state;
     s.position[0].y += lift;
     s.previousPosition = s.position;
-    std::vector<SolverScratch> scratch(copy.size());
     Workers workers(1);
     contact::SelfContact contact;
-    contact.solve(copy, scratch, settings.selfCollision, 1, 1, workers);
+    contact.solve(copy, settings.selfCollision, 1, 1, workers);
     int with = 0;
     for (const contact::SelfContact::Pair& p : contact.pairs()) {
       // The corner as a triangle's corner or an edge's end (as a lone vertex it is far from all).

@@ -623,7 +623,7 @@ TEST(Tethers, AParticleBetweenTwoPinsAtItsRestDistancesStaysOnTheSegment) {
   // point only. Projected onto one ball and then the other it would creep there; the lens
   // projection puts it there in one sweep.
   World world(twoTethers(Vec3{0.0}, Vec3{2.0, 0.0, 0.0}));
-  std::vector<Cloth> cloths = world.cloths();
+  std::vector<Cloth> cloths = world.cloths().copy();
   cloths[0].state.position[1] = Vec3{1.0, -0.5, 0.3};
   cloths[0].state.previousPosition[1] = cloths[0].state.position[1];
   world.restoreCloths(cloths);
@@ -641,7 +641,7 @@ TEST(Tethers, TheLensProjectionIsTheNearestPointInBothBalls) {
     const Vec3 a{0.0}, b{1.5, 0.0, 0.0};
     WorldSettings settings = twoTethers(a, b);
     World world(settings);
-    std::vector<Cloth> cloths = world.cloths();
+    std::vector<Cloth> cloths = world.cloths().copy();
     const Vec3 start{coordinate(random), coordinate(random), coordinate(random)};
     cloths[0].state.position[1] = start;
     cloths[0].state.previousPosition[1] = start;
@@ -1050,7 +1050,7 @@ TEST(Tethers, TheLensIsRightWhereAParticleRestsBeyondAPin) {
   std::uniform_real_distribution<Real> coordinate(-2.0, 2.0), unit(-1.0, 1.0);
   for (int trial = 0; trial < 100; ++trial) {
     World world(settings);
-    std::vector<Cloth> cloths = world.cloths();
+    std::vector<Cloth> cloths = world.cloths().copy();
     const Vec3 start =
         trial == 0 ? Vec3{-1.833, -0.044, 1.528} : Vec3{coordinate(random), coordinate(random), coordinate(random)};
     cloths[0].state.position[4] = start;  // particle (0, 1)
@@ -1096,7 +1096,7 @@ TEST(Tethers, WithAPinCarriedIntoTheOtherBallTheLensIsTheInnerBall) {
       const Vec3 start =
           trial < 5 ? Vec3{along[trial], 0.0, 0.0} : Vec3{coordinate(random), coordinate(random), coordinate(random)};
       World world(settings);
-      std::vector<Cloth> cloths = world.cloths();
+      std::vector<Cloth> cloths = world.cloths().copy();
       ParticleState& s = cloths[0].state;
       s.position[c.movedPin] = s.previousPosition[c.movedPin] = c.movedPin == 1 ? c.a : c.b;
       s.position[c.particle] = s.previousPosition[c.particle] = start;
@@ -1201,7 +1201,7 @@ TEST(FastSweep, ASecondTearOfAChainBreaksTheLinkThatIsPulled) {
   settings.cloths.push_back(cloth);
   World world(settings);
   const auto pull = [&](ParticleIndex particle) {
-    std::vector<Cloth> cloths = world.cloths();
+    std::vector<Cloth> cloths = world.cloths().copy();
     cloths[0].state.position[particle].z += 0.15;
     cloths[0].state.previousPosition[particle] = cloths[0].state.position[particle];
     world.restoreCloths(cloths);

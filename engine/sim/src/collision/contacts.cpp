@@ -177,7 +177,7 @@ void clampTravel(Cloth& cloth, Real maxTravel) {
   }
 }
 
-void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
+void selfCollide(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
                  Workers& workers) {
   // Every particle of every cloth in one spatial hash (Teschner et al. 2003): cells of size d,
   // particles counting-sorted by cell hash, neighbours found in the 27 cells around each one.
@@ -187,7 +187,7 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
   // and the lists are joined in the order of their runs.
   scratch.owner.clear();
   for (std::size_t c = 0; c < cloths.size(); ++c) {
-    for (std::size_t i = 0; i < cloths[c].state.position.size(); ++i) {
+    for (std::size_t i = 0; i < cloths[c].cloth.state.position.size(); ++i) {
       scratch.owner.push_back({static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(i)});
     }
   }
@@ -202,7 +202,7 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
     return static_cast<std::size_t>((h ^ (h >> 29)) & mask);
   };
   const auto positionOf = [&cloths](const SelfCollisionScratch::Owner& o) -> Vec3& {
-    return cloths[o.cloth].state.position[o.particle];
+    return cloths[o.cloth].cloth.state.position[o.particle];
   };
   scratch.cell.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
@@ -247,8 +247,8 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
     for (const auto [a, b] : pairs) {
       const auto [ca, i] = scratch.owner[a];
       const auto [cb, j] = scratch.owner[b];
-      ParticleState& si = cloths[ca].state;
-      ParticleState& sj = cloths[cb].state;
+      ParticleState& si = cloths[ca].cloth.state;
+      ParticleState& sj = cloths[cb].cloth.state;
       const Vec3 between = sj.position[j] - si.position[i];
       const Real distance2 = glm::dot(between, between);
       if (distance2 >= d2 || distance2 < 1e-24) continue;
@@ -256,7 +256,9 @@ void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settin
       if (wi + wj == 0.0) continue;
       // Particles of one cloth closer than d at rest (neighbours) keep their rest distance.
       const Real target =
-          ca == cb ? std::min(d, glm::length(cloths[ca].rest.restPosition(j) - cloths[ca].rest.restPosition(i))) : d;
+          ca == cb
+              ? std::min(d, glm::length(cloths[ca].cloth.rest.restPosition(j) - cloths[ca].cloth.rest.restPosition(i)))
+              : d;
       const Real distance = std::sqrt(distance2);
       if (distance >= target) continue;
       const Vec3 push = between * ((target - distance) / (distance * (wi + wj)));

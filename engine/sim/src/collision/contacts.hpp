@@ -43,7 +43,7 @@ void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders,
 // travels more than maxTravel in a substep on its own momentum, too little to pass through a layer.
 void clampTravel(Cloth& cloth, Real maxTravel);
 // Works across all cloths of the world, so two cloths collide with each other too.
-void selfCollide(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
+void selfCollide(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
                  Workers& workers);
 
 // Whether a self-contact's two points (its weights c over corners v, self_contact.hpp's Contact or a

@@ -237,7 +237,7 @@ std::size_t SelfContact::bytes() const {
   return total;
 }
 
-void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
+void SelfContact::buildMesh(const std::vector<ClothRecord>& cloths) {
   clothOf_.clear();
   rest_.clear();
   clothSize_.clear();
@@ -246,7 +246,7 @@ void SelfContact::buildMesh(const std::vector<Cloth>& cloths) {
   for (std::size_t c = 0; c < cloths.size(); ++c) {
     const auto base = static_cast<std::uint32_t>(clothOf_.size());
     clothStart_.push_back(base);
-    const Cloth& cloth = cloths[c];
+    const Cloth& cloth = cloths[c].cloth;
     // The cloth's size at rest: the diagonal of its rest shape's box, squared (0 with no particle).
     Vec3 lo(std::numeric_limits<Real>::max()), hi(std::numeric_limits<Real>::lowest());
     for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
@@ -407,8 +407,7 @@ void SelfContact::fitTree() {
   }
 }
 
-void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>* scratch,
-                         const std::vector<std::vector<Vec3>>* before) {
+void SelfContact::gather(const std::vector<ClothRecord>& cloths, const std::vector<std::vector<Vec3>>* before) {
   const std::size_t n = clothOf_.size();
   x0_.resize(n);
   x_.resize(n);
@@ -416,15 +415,15 @@ void SelfContact::gather(const std::vector<Cloth>& cloths, const std::vector<Sol
   planes_.clear();
   std::size_t k = 0;
   for (std::size_t c = 0; c < cloths.size(); ++c) {
-    const ParticleState& s = cloths[c].state;
-    const bool planes = scratch && (*scratch)[c].contactCollider.size() == s.position.size();
+    const ParticleState& s = cloths[c].cloth.state;
+    const SolverScratch& contacts = cloths[c].work->solver;
+    const bool planes = !before && contacts.contactCollider.size() == s.position.size();
     for (std::size_t i = 0; i < s.position.size(); ++i, ++k) {
       // Where the substep began (the integration left it there), or where the move began.
       x0_[k] = before ? (*before)[c][i] : s.previousPosition[i];
       x_[k] = s.position[i];
       w_[k] = s.inverseMass[i];
-      if (planes && (*scratch)[c].contactCollider[i] >= 0) {
-        const SolverScratch& contacts = (*scratch)[c];
+      if (planes && contacts.contactCollider[i] >= 0) {
         planes_.push_back({static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(i),
                            contacts.contactNormal[i], contacts.contactOffset[i]});
       }
@@ -1039,7 +1038,7 @@ void SelfContact::measurePairs(Real distance, Workers& workers) {
   xMeasured_ = x_;
 }
 
-void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch) {
+void SelfContact::sweep(Real distance, Real friction, std::vector<ClothRecord>& cloths) {
   const auto gapNow = [&](const Contact& p) {
     Real g = -p.target;
     for (int k = 0; k < 4; ++k) g += p.c[k] * glm::dot(p.normal, x_[p.v[k]]);
@@ -1080,13 +1079,13 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
       const Real gap = glm::dot(plane.normal, x_[plane.particle]) - plane.offset;
       if (gap < 0.0) {
         x_[plane.particle] -= plane.normal * gap;
-        scratch[plane.cloth].contactDepth[plane.index] -= gap;
+        cloths[plane.cloth].work->solver.contactDepth[plane.index] -= gap;
       }
     }
   }
   std::int64_t pushed = 0;
   // What the sweeps pushed, for the next substep's constraint sweeps (SolverScratch::layerContacts).
-  for (SolverScratch& each : scratch) each.layerContacts.clear();
+  for (ClothRecord& each : cloths) each.work->solver.layerContacts.clear();
   for (const std::uint32_t i : active) {
     const Contact& p = contacts_[i];
     if (p.push <= 0.0) continue;
@@ -1100,7 +1099,7 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<SolverScratch>
     held.normal = p.normal;
     held.target = p.target;
     held.edges = p.edges;
-    scratch[c].layerContacts.push_back(held);
+    cloths[c].work->solver.layerContacts.push_back(held);
   }
   for (const std::uint32_t i : active) {
     Contact& p = contacts_[i];
@@ -1561,19 +1560,19 @@ void SelfContact::primitivesMoved() {
   }
 }
 
-void SelfContact::scatter(std::vector<Cloth>& cloths) const {
+void SelfContact::scatter(std::vector<ClothRecord>& cloths) const {
   std::size_t k = 0;
-  for (Cloth& cloth : cloths) {
-    ParticleState& s = cloth.state;
+  for (ClothRecord& record : cloths) {
+    ParticleState& s = record.cloth.state;
     for (std::size_t i = 0; i < s.position.size(); ++i, ++k) s.position[i] = x_[k];
   }
 }
 
-bool SelfContact::prepare(const std::vector<Cloth>& cloths, std::uint64_t topologyVersion) {
+bool SelfContact::prepare(const std::vector<ClothRecord>& cloths, std::uint64_t topologyVersion) {
   std::size_t n = 0, nt = 0;
-  for (const Cloth& cloth : cloths) {
-    n += cloth.state.position.size();
-    nt += cloth.rest.triangles.size();
+  for (const ClothRecord& record : cloths) {
+    n += record.cloth.state.position.size();
+    nt += record.cloth.rest.triangles.size();
   }
   if (topologyVersion == meshVersion_ && n == meshParticles_ && nt == triangles_.size()) return false;
   buildMesh(cloths);
@@ -1581,10 +1580,10 @@ bool SelfContact::prepare(const std::vector<Cloth>& cloths, std::uint64_t topolo
   return true;
 }
 
-void SelfContact::settle(std::vector<Cloth>& cloths, const std::vector<std::vector<Vec3>>& before,
+void SelfContact::settle(std::vector<ClothRecord>& cloths, const std::vector<std::vector<Vec3>>& before,
                          const SelfCollisionSettings& settings, std::uint64_t topologyVersion, Workers& workers) {
   prepare(cloths, topologyVersion);
-  gather(cloths, nullptr, &before);
+  gather(cloths, &before);
   findPairs(settings.distance, 1.0, workers);
   measurePairs(settings.distance, workers);
   failSafe(settings.distance, workers);
@@ -1592,28 +1591,25 @@ void SelfContact::settle(std::vector<Cloth>& cloths, const std::vector<std::vect
   distance_ = -1.0;  // the pairs were for this move: the next substep finds its own
 }
 
-void SelfContact::solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
-                        const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
-                        Workers& workers, PartClock* clock) {
+void SelfContact::solve(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings,
+                        std::uint64_t topologyVersion, int substepsLeft, Workers& workers, PartClock* clock) {
   PartClock untimed;
   PartClock& parts = clock ? *clock : untimed;
-  parts.time(Stage::broadPhase,
-             [&] { findPairsIfNeeded(cloths, scratch, settings, topologyVersion, substepsLeft, workers); });
+  parts.time(Stage::broadPhase, [&] { findPairsIfNeeded(cloths, settings, topologyVersion, substepsLeft, workers); });
   parts.time(Stage::narrowPhase, [&] {
     measurePairs(settings.distance, workers);
     stats_.pairs = static_cast<std::int64_t>(pairs_.size());
   });
   parts.time(Stage::contactSweep, [&] {
-    sweep(settings.distance, settings.friction, scratch);
+    sweep(settings.distance, settings.friction, cloths);
     scatter(cloths);
   });
 }
 
-void SelfContact::findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
-                                    const SelfCollisionSettings& settings, std::uint64_t topologyVersion,
-                                    int substepsLeft, Workers& workers) {
+void SelfContact::findPairsIfNeeded(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings,
+                                    std::uint64_t topologyVersion, int substepsLeft, Workers& workers) {
   const bool fresh = prepare(cloths, topologyVersion);
-  gather(cloths, &scratch, nullptr);
+  gather(cloths, nullptr);
   // The pairs found at a substep serve on while every particle, at x0 and now, keeps half a
   // `distance` inside its box: two primitives within `distance` of each other are then still among
   // them. Where few particles did not (fewer than one in kStraysForSearch), only theirs are paired
@@ -1636,13 +1632,13 @@ void SelfContact::findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<Solv
   reused_ = false;
 }
 
-void SelfContact::finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers,
+void SelfContact::finish(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings, Workers& workers,
                          PartClock* clock) {
   PartClock untimed;
   (clock ? *clock : untimed).time(Stage::failSafe, [&] {
     std::size_t k = 0;
-    for (const Cloth& cloth : cloths) {
-      for (const Vec3& x : cloth.state.position) x_[k++] = x;
+    for (const ClothRecord& record : cloths) {
+      for (const Vec3& x : record.cloth.state.position) x_[k++] = x;
     }
     failSafe(settings.distance, workers);
     scatter(cloths);

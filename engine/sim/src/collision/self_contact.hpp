@@ -58,6 +58,7 @@
 #include <utility>
 #include <vector>
 
+#include "cloth_work.hpp"
 #include "collision/exact_triangles.hpp"
 #include "drape/sim/settings.hpp"
 #include "drape/sim/world.hpp"
@@ -71,19 +72,19 @@ class SelfContact {
  public:
   // A substep's self-contact comes in two calls, and the world applies the colliders' friction
   // between them (contact::friction), so that it answers to the weight the layers above put on a
-  // layer, and the fail-safe still has the last word. `scratch`: each cloth's collider contacts of
-  // this substep; the sweeps keep them too (a layer pushed down is not pushed through the table),
-  // and what they push out counts into the contact's depth, as the constraint sweeps' does.
-  // `substepsLeft`: in the step, this one included (the pairs found serve them all while they can).
-  // `parts` times the broad and the narrow phase, the sweeps and the fail-safe.
-  void solve(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch, const SelfCollisionSettings& settings,
-             std::uint64_t topologyVersion, int substepsLeft, Workers& workers, PartClock* parts = nullptr);
-  void finish(std::vector<Cloth>& cloths, const SelfCollisionSettings& settings, Workers& workers,
+  // layer, and the fail-safe still has the last word. Each cloth's solver scratch (in its record)
+  // holds its collider contacts of this substep; the sweeps keep them too (a layer pushed down is not pushed through
+  // the table), and what they push out counts into the contact's depth, as the constraint sweeps' does. `substepsLeft`:
+  // in the step, this one included (the pairs found serve them all while they can). `parts` times the broad and the
+  // narrow phase, the sweeps and the fail-safe.
+  void solve(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings, std::uint64_t topologyVersion,
+             int substepsLeft, Workers& workers, PartClock* parts = nullptr);
+  void finish(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings, Workers& workers,
               PartClock* parts = nullptr);
   // Keeps a move made outside the substeps (a tear's relaxation, a cut putting particles on its
   // line) from passing cloth through cloth: the fail-safe alone, from `before` (per cloth, where each
   // particle was) to where the particles are, as if a substep had moved them so.
-  void settle(std::vector<Cloth>& cloths, const std::vector<std::vector<Vec3>>& before,
+  void settle(std::vector<ClothRecord>& cloths, const std::vector<std::vector<Vec3>>& before,
               const SelfCollisionSettings& settings, std::uint64_t topologyVersion, Workers& workers);
   const SelfContactStats& stats() const { return stats_; }
   std::size_t bytes() const;
@@ -133,20 +134,18 @@ class SelfContact {
 
  private:
   // Makes the mesh again if the topology changed; true if it did.
-  bool prepare(const std::vector<Cloth>& cloths, std::uint64_t topologyVersion);
+  bool prepare(const std::vector<ClothRecord>& cloths, std::uint64_t topologyVersion);
   // The broad phase: the pairs that may come within reach, found again where the last ones no
   // longer serve.
-  void findPairsIfNeeded(std::vector<Cloth>& cloths, std::vector<SolverScratch>& scratch,
-                         const SelfCollisionSettings& settings, std::uint64_t topologyVersion, int substepsLeft,
-                         Workers& workers);
-  void buildMesh(const std::vector<Cloth>& cloths);
+  void findPairsIfNeeded(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings,
+                         std::uint64_t topologyVersion, int substepsLeft, Workers& workers);
+  void buildMesh(const std::vector<ClothRecord>& cloths);
   void buildTree();
   void fitTree();
   // Positions and inverse masses into the world's numbering; x0 from `before` if given (settle),
-  // else each particle's previous position, and the collider contacts from `scratch` if given.
-  void gather(const std::vector<Cloth>& cloths, const std::vector<SolverScratch>* scratch,
-              const std::vector<std::vector<Vec3>>* before);
-  void scatter(std::vector<Cloth>& cloths) const;
+  // else each particle's previous position, and then the collider contacts from the cloths' scratch.
+  void gather(const std::vector<ClothRecord>& cloths, const std::vector<std::vector<Vec3>>* before);
+  void scatter(std::vector<ClothRecord>& cloths) const;
   void findPairs(Real distance, Real ahead, Workers& workers);
   void measurePairs(Real distance, Workers& workers);
   Contact measure(Pair& pair, Real distance) const;
@@ -180,7 +179,7 @@ class SelfContact {
     if (fromX0) r = std::max(r, from(x0_[i]));
     reach_[i] = std::sqrt(r);
   }
-  void sweep(Real distance, Real friction, std::vector<SolverScratch>& scratch);
+  void sweep(Real distance, Real friction, std::vector<ClothRecord>& cloths);
   void failSafe(Real distance, Workers& workers);
   // In the fail-safe's later rounds: primitiveMoved_ from movedTriangles_.
   void primitivesMoved();

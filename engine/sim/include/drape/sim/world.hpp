@@ -6,9 +6,11 @@
 // before that step, and the world refuses to step further. The caller decides what to tell whom.
 #pragma once
 
+#include <compare>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -83,7 +85,7 @@ struct SelfContactStats {
 };
 
 class Workers;
-struct SolverScratch;  // src/solver_scratch.hpp: the solver's own
+struct ClothWork;  // src/cloth_work.hpp: what a world keeps for one cloth alone
 struct SelfCollisionScratch;
 class PartClock;
 namespace contact {
@@ -101,6 +103,69 @@ struct MemoryUse {
   std::size_t solver = 0;  // scratch: contacts, wind, multipliers, batches, line solves, fingers, self-collision
   std::size_t guard = 0;   // the copy of the last good positions a divergence goes back to
   std::size_t total() const { return state + rest + constraints + topology + tethers + lines + solver + guard; }
+};
+
+// A cloth in a world, with what the world keeps for that cloth alone (its solver's plan and working
+// arrays, which of its particles fingers hold, the guard's copy of its positions): one record, so
+// that nothing kept per cloth can fall out of step with the cloths as they are added, removed,
+// restored, torn or cut.
+struct ClothRecord {
+  Cloth cloth;
+  std::unique_ptr<ClothWork> work;  // never null
+
+  explicit ClothRecord(Cloth cloth);
+  ClothRecord(ClothRecord&&) noexcept;
+  ClothRecord& operator=(ClothRecord&&) noexcept;
+  ~ClothRecord();
+};
+
+// A world's cloths, in order (World::cloths()): read like a vector of them, copied with copy().
+// It reads the world's records, so it is valid while the world is and sees the cloths as they are.
+class ClothList {
+ public:
+  class Iterator {
+   public:
+    using iterator_category = std::random_access_iterator_tag;
+    using value_type = Cloth;
+    using difference_type = std::ptrdiff_t;
+    using pointer = const Cloth*;
+    using reference = const Cloth&;
+    Iterator() = default;
+    explicit Iterator(std::vector<ClothRecord>::const_iterator at) : at_(at) {}
+    reference operator*() const { return at_->cloth; }
+    pointer operator->() const { return &at_->cloth; }
+    reference operator[](difference_type k) const { return at_[k].cloth; }
+    Iterator& operator++() { return ++at_, *this; }
+    Iterator operator++(int) { return Iterator(at_++); }
+    Iterator& operator--() { return --at_, *this; }
+    Iterator operator--(int) { return Iterator(at_--); }
+    Iterator& operator+=(difference_type k) { return at_ += k, *this; }
+    Iterator& operator-=(difference_type k) { return at_ -= k, *this; }
+    friend Iterator operator+(Iterator i, difference_type k) { return i += k; }
+    friend Iterator operator+(difference_type k, Iterator i) { return i += k; }
+    friend Iterator operator-(Iterator i, difference_type k) { return i -= k; }
+    friend difference_type operator-(const Iterator& l, const Iterator& r) { return l.at_ - r.at_; }
+    friend auto operator<=>(const Iterator& l, const Iterator& r) = default;
+    friend bool operator==(const Iterator& l, const Iterator& r) = default;
+
+   private:
+    std::vector<ClothRecord>::const_iterator at_;
+  };
+
+  explicit ClothList(const std::vector<ClothRecord>& records) : records_(&records) {}
+  std::size_t size() const { return records_->size(); }
+  bool empty() const { return records_->empty(); }
+  const Cloth& operator[](std::size_t i) const { return (*records_)[i].cloth; }
+  const Cloth& at(std::size_t i) const { return records_->at(i).cloth; }
+  const Cloth& front() const { return records_->front().cloth; }
+  const Cloth& back() const { return records_->back().cloth; }
+  Iterator begin() const { return Iterator(records_->begin()); }
+  Iterator end() const { return Iterator(records_->end()); }
+  // The cloths as they are now, each copied (to keep, to change, to restore later).
+  std::vector<Cloth> copy() const;
+
+ private:
+  const std::vector<ClothRecord>* records_;
 };
 
 inline constexpr int kMaxThreads = 64;
@@ -140,8 +205,10 @@ class World {
   StepStatus step();
   StepStatus run(std::int64_t steps);
 
+  // The world's settings as it runs now. Its cloths are not kept here (the list is empty): each
+  // cloth's own are cloths()[i].settings, with it in its record.
   const WorldSettings& settings() const { return settings_; }
-  const std::vector<Cloth>& cloths() const { return cloths_; }
+  ClothList cloths() const { return ClothList(records_); }
   const std::vector<Collider>& colliders() const { return colliders_; }
   std::int64_t stepCount() const { return stepCount_; }
   double time() const { return static_cast<double>(stepCount_) * settings_.solver.dt; }
@@ -258,14 +325,13 @@ class World {
   void checkInvariants() const;
   Finger* findFinger(int id);
 
-  WorldSettings settings_;
-  std::vector<Cloth> cloths_;
+  WorldSettings settings_;            // cloths: none (each record's cloth has its own)
+  std::vector<ClothRecord> records_;  // one a cloth
   Profile profile_;
   std::int64_t stepCount_ = 0;
   std::uint64_t topologyVersion_ = 0;
   bool historyStarted_ = false;
   std::optional<Divergence> divergence_;
-  std::vector<SolverScratch> scratch_;  // per cloth
   std::vector<Collider> colliders_;
   std::unique_ptr<SelfCollisionScratch> selfCollisionScratch_;  // made with the world
   std::unique_ptr<contact::SelfContact> selfContact_;           // made at the first substep that needs it
@@ -281,15 +347,9 @@ class World {
     integration,  // in lastGood_, copied by the first substep's integration as it reads them
     before,       // in lastGood_, copied before the step
   };
-  GuardCopy guardCopy_ = GuardCopy::before;
-  std::vector<std::vector<Vec3>> lastGood_;  // per cloth, unless guardCopy_ is none
+  GuardCopy guardCopy_ = GuardCopy::before;  // (into each record's ClothWork::lastGood)
   std::vector<Finger> fingers_;
-  // Per cloth and particle: 1 while a finger holds it. Empty until a finger first holds some of the
-  // cloth: a scene no finger touches does not pay a byte a particle for it.
-  std::vector<std::vector<std::uint8_t>> held_;
-  bool isHeld(std::size_t cloth, std::size_t particle) const {
-    return !held_[cloth].empty() && held_[cloth][particle] != 0;
-  }
+  bool isHeld(std::size_t cloth, std::size_t particle) const;
   std::unique_ptr<Workers> workers_;
 };
 
