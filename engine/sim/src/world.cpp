@@ -545,7 +545,7 @@ void World::startHistory(std::size_t c) {
     position::startHistory(records_[c].cloth, settings_.gravity + settings_.air.drag * settings_.air.velocity,
                            settings_.solver.damping + settings_.air.drag, h);
   } else {
-    force::startHistory(records_[c].cloth, settings_, h, records_[c].work->solver);
+    force::startHistory(records_[c].cloth, force::makeSubstep(settings_, h), records_[c].work->solver);
   }
 }
 
@@ -646,16 +646,15 @@ void World::positionSubstep(Real h) {
 
 // A substep of the force model: the integrator's stage (one of five), then the colliders.
 void World::forceSubstep(Real h) {
-  timed(Stage::fingers, [&](PartClock&) { moveFingers(h); });
-  const Integrator integrator = settings_.solver.integrator;
-  timed(integratorStage(integrator), [&](PartClock&) {
-    for (std::size_t c = 0; c < records_.size(); ++c)
-      force::step(integrator, records_[c].cloth, settings_, h, records_[c].work->solver);
+  const force::Substep substep = force::makeSubstep(settings_, h);
+  timed(Stage::fingers, [&](PartClock&) { moveFingers(substep.h); });
+  timed(integratorStage(substep.integrator), [&](PartClock&) {
+    for (ClothRecord& record : records_) force::step(record.cloth, substep, record.work->solver);
   });
   timed(Stage::collideForces, [&](PartClock&) {
     moveColliders();
-    for (std::size_t c = 0; c < records_.size(); ++c)
-      contact::respondWithVelocities(records_[c].cloth, colliders_, h, records_[c].work->solver);
+    for (ClothRecord& record : records_)
+      contact::respondWithVelocities(record.cloth, colliders_, substep.h, record.work->solver);
   });
 }
 
@@ -1268,7 +1267,8 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
     sortUnique(cloth.tetherPins);  // as makeCloth keeps them
     buildTethers(c);
     if (settings_.solver.model == Model::force)
-      force::startHistory(cloth, settings_, static_cast<Real>(substepDt()), records_[c].work->solver);
+      force::startHistory(cloth, force::makeSubstep(settings_, static_cast<Real>(substepDt())),
+                          records_[c].work->solver);
   }
   buildPipeline();
   // The cloths come with their own history (x_prev, velocities): the next step must not restart it.
