@@ -120,7 +120,8 @@ struct ClothRecord {
 };
 
 // A world's cloths, in order (World::cloths()): read like a vector of them, copied with copy().
-// It reads the world's records, so it is valid while the world is and sees the cloths as they are.
+// It reads the world's records, so it sees the cloths as they are, and is valid while the world
+// is (not after the world is moved from).
 class ClothList {
  public:
   class Iterator {
