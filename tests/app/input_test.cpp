@@ -522,8 +522,9 @@ TEST(Session, AnotherModelRestartsTheSceneWithThatModelsMaterials) {
   const sim::WorldSettings& settings = session.world().settings();
   EXPECT_EQ(settings.solver.model, sim::Model::force);
   EXPECT_EQ(settings.solver.integrator, sim::Integrator::rk4);
-  EXPECT_EQ(settings.cloths[0].material(sim::ConstraintKind::stretch).stiffness, 2000.0);  // N/m now
-  EXPECT_FALSE(session.world().hasStage(sim::Stage::selfCollide));                         // the force model has none
+  EXPECT_EQ(session.world().cloths()[0].settings.material(sim::ConstraintKind::stretch).stiffness,
+            2000.0);                                                // N/m now
+  EXPECT_FALSE(session.world().hasStage(sim::Stage::selfCollide));  // the force model has none
   // Its springs are stiff for so light a cloth (0.17 g a particle): omega <= sqrt(2 (4 * 2000 + 4 *
   // 2000 + 4 * 200) / 1.74e-4) = 13900 rad/s and a decay rate <= 2 (4 * 1 + 4 * 1 + 4 * 0.1) / 1.74e-4
   // = 96600 /s (Gershgorin), so RK4 wants h < 2.78 / 110500 s: the switch takes ~740 substeps of the

@@ -785,7 +785,7 @@ StepStatus World::step() {
   return StepStatus::ok;
 }
 
-// What every step leaves as it found it: one record per cloth in each per-cloth array, each
+// What every step leaves as it found it: each record's arrays made for its cloth, each
 // particle's arrays as long as its cloth's positions, and the fingers' grips on particles that exist.
 void World::checkInvariants() const {
   for (std::size_t c = 0; c < records_.size(); ++c) {
@@ -1248,8 +1248,12 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   }
   require(particles <= static_cast<std::size_t>(kMaxParticles), "too many particles");
   while (!fingers_.empty()) releaseFinger(fingers_.front().id);
-  records_.clear();
-  for (Cloth& cloth : cloths) records_.emplace_back(std::move(cloth));
+  // Made apart and then moved in (which cannot throw): a failure to allocate leaves the world as
+  // it was.
+  std::vector<ClothRecord> records;
+  records.reserve(cloths.size());
+  for (Cloth& cloth : cloths) records.emplace_back(std::move(cloth));
+  records_ = std::move(records);
   for (std::size_t c = 0; c < records_.size(); ++c) {
     Cloth& cloth = records_[c].cloth;
     cloth.settings = withFabricMaterials(cloth.settings);

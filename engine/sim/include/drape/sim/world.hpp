@@ -13,6 +13,7 @@
 #include <iterator>
 #include <memory>
 #include <optional>
+#include <ranges>
 #include <vector>
 
 #include "drape/sim/cloth.hpp"
@@ -121,7 +122,8 @@ struct ClothRecord {
 
 // A world's cloths, in order (World::cloths()): read like a vector of them, copied with copy().
 // It reads the world's records, so it sees the cloths as they are, and is valid while the world
-// is (not after the world is moved from).
+// is; a reference to a cloth or an iterator from it is not, once a cloth is added, removed or
+// restored (as for a vector).
 class ClothList {
  public:
   class Iterator {
@@ -207,7 +209,8 @@ class World {
   StepStatus run(std::int64_t steps);
 
   // The world's settings as it runs now. Its cloths are not kept here (the list is empty): each
-  // cloth's own are cloths()[i].settings, with it in its record.
+  // cloth's own are cloths()[i].settings, with it in its record, as the world uses them (a
+  // fabric's stretch and shear as XPBD compliances, its bend links none).
   const WorldSettings& settings() const { return settings_; }
   ClothList cloths() const { return ClothList(records_); }
   const std::vector<Collider>& colliders() const { return colliders_; }
@@ -345,8 +348,8 @@ class World {
   // Where the guard finds the positions before the current step (World::step).
   enum class GuardCopy : std::uint8_t {
     none,         // in the previous positions: one substep's integration left them there untouched
-    integration,  // in lastGood_, copied by the first substep's integration as it reads them
-    before,       // in lastGood_, copied before the step
+    integration,  // in each record's ClothWork::lastGood, copied by the first substep's integration
+    before,       // in each record's ClothWork::lastGood, copied before the step
   };
   GuardCopy guardCopy_ = GuardCopy::before;  // (into each record's ClothWork::lastGood)
   std::vector<Finger> fingers_;
@@ -355,3 +358,7 @@ class World {
 };
 
 }  // namespace drape::sim
+
+// A ClothList's iterators point into the world, not into the list: they outlive it.
+template <>
+inline constexpr bool std::ranges::enable_borrowed_range<drape::sim::ClothList> = true;
