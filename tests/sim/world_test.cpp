@@ -5,10 +5,13 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <ranges>
 #include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
+
+#include <glm/geometric.hpp>
 
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
@@ -343,6 +346,55 @@ TEST(Guard, AStableRunNeverTrips) {
   World world(test::hangingSheet(16, 10, 2));
   EXPECT_EQ(world.run(300), StepStatus::ok);
   EXPECT_FALSE(world.divergence().has_value());
+}
+
+// Each cloth is one record (ClothRecord): the cloth and what the world keeps for it alone, the
+// held flags among them, go together as cloths come and go. Two sheets, the second held at a corner
+// by a finger; the first is removed, and the finger still carries the second's corner (its grip
+// moved with it), which a second finger cannot take (its held flag moved with it too: were it left
+// behind, the second finger would take the corner as a free particle).
+TEST(World, KeepsEachClothWithWhatItHoldsForItAsClothsComeAndGo) {
+  WorldSettings settings = test::hangingSheet(6, 10, 2);
+  settings.gravity = Vec3{0.0, -9.81, 0.0};
+  ClothSettings second = settings.cloths[0];
+  second.lattice = {5, 4, 0.4, 0.3, Vec3{2.0, 1.0, 0.0}, LatticePlane::xz};
+  second.pins.clear();
+  second.fabric = Fabric{};
+  settings.cloths.push_back(second);
+  World world(settings);
+
+  // The list reads the records, in order; a copy is the cloths as they are.
+  const ClothList list = world.cloths();
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_EQ(list[0].state.position.size(), 36u);
+  EXPECT_EQ(list[1].state.position.size(), 20u);
+  std::size_t particles = 0;
+  for (const Cloth& cloth : list) particles += cloth.state.position.size();
+  EXPECT_EQ(particles, 56u);
+  const auto small = std::ranges::find_if(world.cloths(), [](const Cloth& c) { return c.state.position.size() == 20; });
+  EXPECT_EQ(small - list.begin(), 1);
+  EXPECT_EQ(&*small, &list.back());
+  const std::vector<Cloth> copied = list.copy();
+  ASSERT_EQ(copied.size(), 2u);
+  EXPECT_EQ(copied[1].state.position, list[1].state.position);
+
+  // Each cloth's settings are its own, as the world uses them; the world's list of them is empty.
+  EXPECT_TRUE(world.settings().cloths.empty());
+  EXPECT_EQ(list[1].settings.lattice.columns, 5);
+  EXPECT_EQ(list[1].settings.material(ConstraintKind::stretch).compliance, 1.0 / Fabric{}.stretchStiffness);
+
+  const Vec3 corner = list[1].state.position[0];
+  ASSERT_EQ(world.pressFinger(3, corner, 0.01), 1);
+  world.removeCloth(0);
+  ASSERT_EQ(world.cloths().size(), 1u);
+  EXPECT_EQ(world.finger(3)->grips.front().cloth, 0);
+  EXPECT_EQ(world.pressFinger(4, corner, 0.01), 0);
+  const Vec3 lifted = corner + Vec3{0.0, 0.2, 0.0};
+  world.moveFinger(3, lifted);
+  ASSERT_EQ(world.run(30), StepStatus::ok);
+  const Cloth& left = world.cloths()[0];
+  EXPECT_LT(glm::length(left.state.position[0] - lifted), 1e-9);
+  EXPECT_LT(left.state.position[19].y, corner.y - 0.05);  // the far corner, free, fell
 }
 
 TEST(World, RejectsSettingsOutsideItsLimits) {
