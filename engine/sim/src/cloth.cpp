@@ -102,6 +102,16 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
     }
     rest.triangles.push_back(t);
   }
+  rest.constraints = meshConstraints(rest, rest.triangles, mesh.nodes, selection);
+  return rest;
+}
+
+std::array<std::vector<DistanceConstraint>, kConstraintKindCount> meshConstraints(
+    const ClothRest& rest, const std::vector<glm::uvec3>& triangles, const std::vector<glm::ivec2>& nodes,
+    ConstraintSelection selection) {
+  const std::size_t n = rest.particleCount();
+  std::array<std::vector<DistanceConstraint>, kConstraintKindCount> constraints;
+  if (nodes.size() != n) throw std::invalid_argument("a mesh needs one lattice node (or none) per particle");
 
   // Nodes by (row, column), for finding a particle by its lattice position.
   struct Node {
@@ -111,7 +121,7 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
   };
   std::vector<Node> byNode;
   for (std::size_t p = 0; p < n; ++p) {
-    const glm::ivec2 node = mesh.nodes[p];
+    const glm::ivec2 node = nodes[p];
     if (node == kNoNode) continue;
     if (node.x < 0 || node.y < 0) throw std::invalid_argument("a mesh node has a negative column or row");
     byNode.push_back({node.y, node.x, static_cast<ParticleIndex>(p)});
@@ -125,16 +135,16 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
     if (found == byNode.end() || found->row != row || found->column != column) return std::nullopt;
     return found->particle;
   };
-  const auto onLattice = [&](ParticleIndex p) { return mesh.nodes[p] != kNoNode; };
+  const auto onLattice = [&](ParticleIndex p) { return nodes[p] != kNoNode; };
 
   // Edges as (low << 32 | high), sorted: the triangles', or a chain's lattice neighbours.
   const auto key = [](ParticleIndex a, ParticleIndex b) {
     return static_cast<std::uint64_t>(std::min(a, b)) << 32 | std::max(a, b);
   };
   std::vector<std::uint64_t> edges;
-  if (!mesh.triangles.empty()) {
-    edges.reserve(mesh.triangles.size() * 3);
-    for (const glm::uvec3& t : mesh.triangles) {
+  if (!triangles.empty()) {
+    edges.reserve(triangles.size() * 3);
+    for (const glm::uvec3& t : triangles) {
       for (int k = 0; k < 3; ++k) edges.push_back(key(t[k], t[(k + 1) % 3]));
     }
   } else {
@@ -152,7 +162,7 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
 
   const auto add = [&](ConstraintKind kind, ParticleIndex a, ParticleIndex b) {
     const RestReal restLength = toRestLength(glm::length(rest.restPosition(b) - rest.restPosition(a)));
-    if (restLength > 0.0f) rest.constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
+    if (restLength > 0.0f) constraints[static_cast<std::size_t>(kind)].push_back({a, b, restLength});
   };
 
   // Stretch: every edge but a cell's diagonals; the diagonals, by cell and which: (row, column, 0 for
@@ -161,9 +171,9 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
   for (const std::uint64_t edge : edges) {
     const auto a = static_cast<ParticleIndex>(edge >> 32), b = static_cast<ParticleIndex>(edge & 0xffffffffu);
     if (onLattice(a) && onLattice(b)) {
-      const glm::ivec2 d = mesh.nodes[b] - mesh.nodes[a];
+      const glm::ivec2 d = nodes[b] - nodes[a];
       if (std::abs(d.x) == 1 && std::abs(d.y) == 1) {
-        const glm::ivec2 low = glm::min(mesh.nodes[a], mesh.nodes[b]);
+        const glm::ivec2 low = glm::min(nodes[a], nodes[b]);
         diagonals.push_back({low.y, low.x, d.x == d.y ? 0 : 1});
         continue;
       }
@@ -173,9 +183,9 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
   if (selection.shear) {
     // A whole cell: two triangles within it that leave out opposite corners; its other diagonal too.
     std::vector<std::array<int, 3>> corners;  // (row, column of the cell, corner left out: 0 1 / 2 3)
-    for (const glm::uvec3& t : mesh.triangles) {
+    for (const glm::uvec3& t : triangles) {
       if (!onLattice(t.x) || !onLattice(t.y) || !onLattice(t.z)) continue;
-      const glm::ivec2 a = mesh.nodes[t.x], b = mesh.nodes[t.y], c = mesh.nodes[t.z];
+      const glm::ivec2 a = nodes[t.x], b = nodes[t.y], c = nodes[t.z];
       const glm::ivec2 low = glm::min(a, glm::min(b, c)), high = glm::max(a, glm::max(b, c));
       if (high.x - low.x != 1 || high.y - low.y != 1) continue;
       int missing = 0 + 1 + 2 + 3;
@@ -210,7 +220,7 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
       }
     }
   }
-  return rest;
+  return constraints;
 }
 
 ClothRest buildLattice(const LatticeSpec& spec, ConstraintSelection selection) {

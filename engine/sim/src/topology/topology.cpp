@@ -941,16 +941,33 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
   for (const Pair& pair : again) {
     addTemplates(topology, rest, after, pair.kind, {pair.a, pair.b, pair.restLength}, false);
   }
+  // The links of the children's new edges (those with a particle the split made), by the rules
+  // constrainMesh makes a mesh's by (meshConstraints): a particle made here stands for no lattice
+  // node, so each is stretch. One recipe for each child an edge is on: it lives while one of them
+  // has it.
+  std::vector<glm::uvec3> children;
+  for (const Split& sp : split) {
+    for (const Split::Child& child : sp.children)
+      children.push_back({child.corners[0], child.corners[1], child.corners[2]});
+  }
+  std::vector<std::pair<std::uint64_t, RestReal>> made;  // (edge key, rest length), sorted
+  if (!children.empty()) {
+    const std::vector<glm::ivec2> none(rest.particleCount(), kNoNode);
+    const auto links = meshConstraints(rest, children, none, {true, false, false});
+    for (const DistanceConstraint& c : links[static_cast<std::size_t>(ConstraintKind::stretch)]) {
+      if (c.a >= n0 || c.b >= n0) made.push_back({key(c.a, c.b), c.restLength});
+    }
+    std::sort(made.begin(), made.end());
+  }
   for (const Split& sp : split) {
     for (const Split::Child& child : sp.children) {
       for (int k = 0; k < 3; ++k) {
         const ParticleIndex p = child.corners[k], q = child.corners[(k + 1) % 3];
-        if (p < n0 && q < n0) continue;
-        const Real edge = restEdge(rest, p, q);
-        if (!(edge > 0.0)) continue;
+        const auto link = std::lower_bound(made.begin(), made.end(), std::pair{key(p, q), RestReal{0}});
+        if (link == made.end() || link->first != key(p, q)) continue;
         ConstraintTemplate x;
         x.kind = ConstraintKind::stretch;
-        x.restLength = toRestLength(edge);
+        x.restLength = link->second;
         x.link = ConstraintTemplate::Link::same;
         x.t1 = x.t2 = child.index;
         x.corner1 = static_cast<std::uint8_t>(k);

@@ -142,6 +142,14 @@ struct LatticeMesh {
 // particle, a node off the lattice (negative) or stood for twice, a triangle with a corner out of
 // range or twice, a position not finite.
 ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection = {});
+// The rules constrainMesh makes a mesh's constraints by, over `triangles` of a cloth whose rest
+// positions `rest` has, each particle standing for lattice node nodes[p] (or kNoNode; one a
+// particle): what constrainMesh puts in its lists. Tearing makes the links of the edges a split
+// triangle's children add so (topology.cpp): a particle it inserts stands for no node, so each such
+// edge is stretch. Throws std::invalid_argument as constrainMesh does.
+std::array<std::vector<DistanceConstraint>, kConstraintKindCount> meshConstraints(
+    const ClothRest& rest, const std::vector<glm::uvec3>& triangles, const std::vector<glm::ivec2>& nodes,
+    ConstraintSelection selection = {});
 
 // Builds the lattice (by constrainMesh). Throws std::invalid_argument if the spec is not a valid
 // lattice.
