@@ -81,6 +81,19 @@ double clothShare(const fs::path& png, int& width, int& height) {
 
 json state(const fs::path& file) { return json::parse(read(file)); }
 
+// Shell lines that find the app's window as $window, or fail. xdotool's search walks the window
+// tree, and a window that goes while it looks (as the app starts) ends it with BadWindow and no
+// window (the sanitizer build, slower to start, met it): it asks again every 0.2 s, for up to a
+// minute.
+const std::string kFindWindow =
+    "window=\n"
+    "for i in $(seq 300); do\n"
+    "  window=$(xdotool search --onlyvisible --name '^Drape$' 2>/dev/null | head -n 1)\n"
+    "  [ -n \"$window\" ] && break\n"
+    "  sleep 0.2\n"
+    "done\n"
+    "[ -n \"$window\" ]\n";
+
 TEST_F(App, TouchesPushedThroughSdlTearTheClothAndTheScreenshotShowsIt) {
   const Result result = inDisplay(
       "\"$DRAPE\" desk-tear --replay \"$DRAPE_ASSETS/gestures/tear.json\" --width 640 --height 400 "
@@ -120,11 +133,8 @@ TEST_F(App, AHundredFingersAtOnceAreFine) {
 // to the right with xdotool, and Esc twice; the state at exit is in dragged.json.
 std::string dragAcrossTheDesk(const std::string& first) {
   return "\"$DRAPE\" desk --width 640 --height 400 --exit-after 2000 --out dragged.json &\n"
-         "app=$!\n"
-         "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
-         "[ -n \"$window\" ]\n"
-         "sleep 1\n" +
-         first +
+         "app=$!\n" +
+         kFindWindow + "sleep 1\n" + first +
          "xdotool mousemove --window $window 320 200 mousedown 1\n"
          "for x in 340 360 380 400 420 440 460; do sleep 0.2; xdotool mousemove --window $window $x 200; done\n"
          "sleep 0.5\n"
@@ -172,9 +182,8 @@ TEST_F(App, EscWithTheScenesListOpenClosesTheListAndDoesNotQuit) {
   // is still running (it used to quit); a third Esc quits.
   const Result result = inDisplay(
       "\"$DRAPE\" desk --width 1000 --height 700 --exit-after 100000 &\n"
-      "app=$!\n"
-      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
-      "[ -n \"$window\" ]\n"
+      "app=$!\n" +
+      kFindWindow +
       "sleep 1\n"
       "xdotool mousemove --window $window 760 70 click 1\n"
       "sleep 0.7\n"
@@ -191,9 +200,8 @@ TEST_F(App, EscWithTheScenesListOpenClosesTheListAndDoesNotQuit) {
 TEST_F(App, ResizingAndMinimisingDoNotStopIt) {
   const Result result = inDisplay(
       "\"$DRAPE\" desk --width 640 --height 400 --exit-after 100000 --out state.json &\n"
-      "app=$!\n"
-      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
-      "[ -n \"$window\" ]\n"
+      "app=$!\n" +
+      kFindWindow +
       "xdotool windowsize $window 200 120\n"
       "sleep 0.3\n"
       "xdotool windowsize $window 1 1\n"
@@ -230,9 +238,8 @@ double darkShare(const fs::path& png, double from, double to) {
 TEST_F(App, ThePanelStaysAtTheRightEdgeThroughAResizeToOnePixelAndBack) {
   const Result result = inDisplay(
       "\"$DRAPE\" desk --width 800 --height 500 --exit-after 100000 &\n"
-      "app=$!\n"
-      "window=$(timeout 60 xdotool search --sync --onlyvisible --name '^Drape$' | head -n 1)\n"
-      "[ -n \"$window\" ]\n"
+      "app=$!\n" +
+      kFindWindow +
       "sleep 0.5\n"
       "xdotool windowsize $window 1 1\n"
       "sleep 0.5\n"
