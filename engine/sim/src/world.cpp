@@ -587,16 +587,15 @@ void World::positionSubstep(Real h) {
   const position::Substep substep = position::makeSubstep(settings_, h);
   timed(Stage::fingers, [&](PartClock&) { moveFingers(substep.h); });
   timed(Stage::windPressure, [&](PartClock&) {
-    for (std::size_t c = 0; c < records_.size(); ++c)
-      position::accumulateWindPressure(records_[c].cloth, settings_.air, substep.h,
-                                       records_[c].work->solver.acceleration);
+    for (ClothRecord& record : records_)
+      position::accumulateWindPressure(record.cloth, settings_.air, substep.h, record.work->solver.acceleration);
   });
   timed(Stage::verletIntegrate, [&](PartClock&) {
     const bool keep = guardCopy_ == GuardCopy::integration && substep_ == 0;
-    for (std::size_t c = 0; c < records_.size(); ++c) {
-      std::vector<Vec3>& acceleration = records_[c].work->solver.acceleration;
-      position::integrate(records_[c].cloth, substep, acceleration.empty() ? nullptr : &acceleration, *workers_,
-                          keep ? records_[c].work->lastGood.data() : nullptr);
+    for (ClothRecord& record : records_) {
+      std::vector<Vec3>& acceleration = record.work->solver.acceleration;
+      position::integrate(record.cloth, substep, acceleration.empty() ? nullptr : &acceleration, *workers_,
+                          keep ? record.work->lastGood.data() : nullptr);
     }
   });
   timed(Stage::selfCollide, [&](PartClock&) {
@@ -604,8 +603,7 @@ void World::positionSubstep(Real h) {
   });
   timed(Stage::collide, [&](PartClock&) {
     moveColliders();
-    for (std::size_t c = 0; c < records_.size(); ++c)
-      contact::detect(records_[c].cloth, colliders_, records_[c].work->solver);
+    for (ClothRecord& record : records_) contact::detect(record.cloth, colliders_, record.work->solver);
   });
   timed(Stage::projectConstraints, [&](PartClock& parts) {
     for (std::size_t c = 0; c < records_.size(); ++c) {
@@ -620,8 +618,7 @@ void World::positionSubstep(Real h) {
     }
   });
   timed(Stage::friction, [&](PartClock&) {
-    for (std::size_t c = 0; c < records_.size(); ++c)
-      contact::friction(records_[c].cloth, colliders_, substep.h, records_[c].work->solver);
+    for (ClothRecord& record : records_) contact::friction(record.cloth, colliders_, substep.h, record.work->solver);
   });
   timed(Stage::selfContact, [&](PartClock& parts) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
@@ -629,8 +626,8 @@ void World::positionSubstep(Real h) {
                         *workers_, &parts);
     if (!colliders_.empty()) {
       parts.time(Stage::friction, [&] {
-        for (std::size_t c = 0; c < records_.size(); ++c)
-          contact::friction(records_[c].cloth, colliders_, substep.h, records_[c].work->solver);
+        for (ClothRecord& record : records_)
+          contact::friction(record.cloth, colliders_, substep.h, record.work->solver);
       });
     }
     selfContact_->finish(records_, settings_.selfCollision, *workers_, &parts);

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -45,6 +46,25 @@ void clampTravel(Cloth& cloth, Real maxTravel);
 // Works across all cloths of the world, so two cloths collide with each other too.
 void selfCollide(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings, SelfCollisionScratch& scratch,
                  Workers& workers);
+
+// A self-contact whose free corners would each move more than 1 / kContactLeverage times as far
+// as its points part pushes nothing: a free corner of weight 0.004 in a triangle whose other corners
+// and the vertex fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair
+// apart instead.
+inline constexpr Real kContactLeverage = 0.25;
+
+// How hard a self-contact's two points (weights c over corners v, with inverse masses w) are to
+// part: sum_k c_k^2 w_k, the masses sharing the move; 0 where kContactLeverage says it pushes
+// nothing. Parting them by g moves corner k by c_k w_k g / that along the normal.
+template <class Contact>
+Real partingWeight(const std::vector<Real>& w, const Contact& p) {
+  Real denominator = 0.0, most = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    denominator += p.c[k] * p.c[k] * w[p.v[k]];
+    most = std::max(most, std::abs(p.c[k]) * w[p.v[k]]);
+  }
+  return denominator > kContactLeverage * most ? denominator : 0.0;
+}
 
 // Whether a self-contact's two points (its weights c over corners v, self_contact.hpp's Contact or a
 // SolverScratch::LayerContact) still face each other across its normal at `x`: their offset along

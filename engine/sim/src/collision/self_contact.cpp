@@ -78,7 +78,6 @@ int signChangesIn01(const std::array<Real, 4>& c, std::array<Real, 3>& roots) {
 }
 // Two points closer than this at x0 give no direction to keep apart along.
 constexpr Real kCoincident = 1e-12;
-constexpr Real kLeverage = SolverScratch::kContactLeverage;
 // A pair's separation where nothing is proven.
 constexpr float kUnproven = -std::numeric_limits<float>::infinity();
 // How many times its rest size a triangle or edge may be stretched and still take part (longer
@@ -1045,17 +1044,13 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<ClothRecord>& 
     return g;
   };
   // How far each unit the two points must part moves the particles: 1 / sum_k c_k^2 w_k, so that
-  // the masses share the move; nothing where that would move a particle more than 1 / kLeverage
-  // times as far as the points part (a held vertex against a triangle whose only free corner has a
-  // small weight there: the pair is then left to the fail-safe rather than the corner flung).
+  // the masses share the move; nothing where that would move a particle more than 1 /
+  // kContactLeverage times as far as the points part (a held vertex against a triangle whose only
+  // free corner has a small weight there: the pair is then left to the fail-safe rather than the
+  // corner flung).
   const auto reach = [&](const Contact& p) {
-    Real denominator = 0.0, most = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      denominator += p.c[k] * p.c[k] * w_[p.v[k]];
-      most = std::max(most, std::abs(p.c[k]) * w_[p.v[k]]);
-    }
-    if (!(denominator > kLeverage * most)) return 0.0;
-    return 1.0 / denominator;
+    const Real weight = contact::partingWeight(w_, p);
+    return weight > 0.0 ? 1.0 / weight : 0.0;
   };
   const auto facing = [&](const Contact& p) { return contact::facing(x_, p); };
   // The pairs a sweep can push: within one more `distance` of their target now.

@@ -13,7 +13,7 @@
 //    target apart along n: `distance`, or less for parts of one cloth closer than that at rest. It
 //    is linear in the positions, C(x) = sum_k c_k (n . x_k) - target >= 0 with sum_k c_k = 0, and
 //    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding), except
-//    where that would move a particle far more than the points part (kLeverage). A pair whose
+//    where that would move a particle far more than the points part (kContactLeverage, contacts.hpp). A pair whose
 //    corners lie more than `distance` apart along the line between its centres, or else along the
 //    line between its closest points at x0, all through the substep is far: not pushed (the
 //    fail-safe proves it apart by those lines). What was proven of a pair (how far apart, along a

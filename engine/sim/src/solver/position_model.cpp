@@ -353,14 +353,10 @@ void holdLayers(Cloth& cloth, const SolverScratch& scratch) {
   std::vector<Vec3>& x = cloth.state.position;
   const std::vector<Real>& w = cloth.state.inverseMass;
   for (const SolverScratch::LayerContact& p : scratch.layerContacts) {
-    Real denominator = 0.0, most = 0.0;
+    const Real denominator = contact::partingWeight(w, p);
+    if (!(denominator > 0.0)) continue;
     Vec3 between{0.0};
-    for (int k = 0; k < 4; ++k) {
-      between += x[p.v[k]] * p.c[k];
-      denominator += p.c[k] * p.c[k] * w[p.v[k]];
-      most = std::max(most, std::abs(p.c[k]) * w[p.v[k]]);
-    }
-    if (!(denominator > SolverScratch::kContactLeverage * most)) continue;
+    for (int k = 0; k < 4; ++k) between += x[p.v[k]] * p.c[k];
     // Across the surface as it is now: the triangle's normal, or both edges', turned the way the
     // measured one faces (that one where they turned more than 60 degrees since, or where the two
     // edges, or the triangle's two sides, lie within 14 degrees of parallel, so that their cross

@@ -47,12 +47,8 @@ struct SolverScratch {
   // cloth (in its own numbering; self_contact.hpp's Contact): held again after each of this
   // substep's constraint sweeps (position::projectConstraints), so that the sweeps settle with the
   // layers apart instead of drawing them together for the contacts to push apart once more.
-  // Emptied as each step begins: a step starts from its state alone (a snapshot, a tear).
-  // A contact whose free corners would each move more than 1 / kContactLeverage times as far as
-  // its points part pushes nothing: a free corner of weight 0.004 in a triangle whose other corners
-  // and the vertex fingers hold would be flung 250 times the gap. The fail-safe keeps such a pair
-  // apart instead.
-  static constexpr Real kContactLeverage = 0.25;
+  // Emptied as each step begins: a step starts from its state alone (a snapshot, a tear). Held as
+  // the contact sweep holds them (contact::partingWeight, contact::facing).
   struct LayerContact {
     ParticleIndex v[4];
     Real c[4];    // the weights of its two points: sum_k c_k (n . x_k) >= target
