@@ -1,9 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -46,10 +48,49 @@ TEST(Lattice, ConstraintsComeInTheSeedsOrderInEitherPlane) {
         if (row + 2 < rows) expected[2].push_back({at(column, row), at(column, row + 2)});
       }
     }
+    // meshConstraints lists them so.
+    std::vector<glm::ivec2> nodes;
+    for (int row = 0; row < rows; ++row) {
+      for (int column = 0; column < columns; ++column) nodes.push_back({column, row});
+    }
+    const auto listed = meshConstraints(rest, rest.triangles, nodes);
     for (const ConstraintKind kind : kConstraintKinds) {
       std::vector<std::pair<ParticleIndex, ParticleIndex>> made;
-      for (const DistanceConstraint& c : rest.of(kind)) made.push_back({c.a, c.b});
+      for (const DistanceConstraint& c : listed[static_cast<std::size_t>(kind)]) made.push_back({c.a, c.b});
       EXPECT_EQ(made, expected[static_cast<std::size_t>(kind)]) << name(kind) << " in " << name(plane);
+    }
+    // The lattice keeps the same constraints in the engine's one order (orderConstraints): the
+    // stretch links the rows' line by line, then the columns', each along its line; shear and bend
+    // in batches no two of whose constraints share a particle.
+    std::vector<std::pair<ParticleIndex, ParticleIndex>> lines;
+    for (int row = 0; row < rows; ++row) {
+      for (int column = 0; column + 1 < columns; ++column) lines.push_back({at(column, row), at(column + 1, row)});
+    }
+    for (int column = 0; column < columns; ++column) {
+      for (int row = 0; row + 1 < rows; ++row) lines.push_back({at(column, row), at(column, row + 1)});
+    }
+    for (const ConstraintKind kind : kConstraintKinds) {
+      std::vector<std::pair<ParticleIndex, ParticleIndex>> kept;
+      for (const DistanceConstraint& c : rest.of(kind)) kept.push_back({c.a, c.b});
+      if (kind == ConstraintKind::stretch) {
+        EXPECT_EQ(kept, lines) << name(plane);
+        continue;
+      }
+      std::vector<std::pair<ParticleIndex, ParticleIndex>> sorted = kept;
+      std::sort(sorted.begin(), sorted.end());
+      EXPECT_EQ(sorted, expected[static_cast<std::size_t>(kind)]) << name(kind) << " in " << name(plane);
+      EXPECT_NE(kept, expected[static_cast<std::size_t>(kind)]) << name(kind) << " in " << name(plane);
+      // Batches: a run with no particle twice, and the next constraint shares one with the run.
+      std::vector<int> seen(rest.particleCount(), 0);
+      int batches = 1;
+      for (const auto& [a, b] : kept) {
+        if (seen[a] || seen[b]) {
+          ++batches;
+          std::fill(seen.begin(), seen.end(), 0);
+        }
+        seen[a] = seen[b] = 1;
+      }
+      EXPECT_LE(batches, 6) << name(kind) << " in " << name(plane);
     }
   }
 }
@@ -67,9 +108,18 @@ TEST(ConstrainMesh, APartCellGetsOnlyItsOwnDiagonalAndAnOffLatticeCornerStretch)
   mesh.nodes = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 0}, kNoNode};
   mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {1, 3, 4}, {4, 3, 5}};
   const ClothRest rest = constrainMesh(mesh);
+  // In lattice order as meshConstraints lists them (constrainMesh keeps the same in the engine's
+  // order).
+  const auto listed = meshConstraints(rest, rest.triangles, mesh.nodes);
   const auto pairs = [&](ConstraintKind kind) {
-    std::vector<std::pair<ParticleIndex, ParticleIndex>> made;
-    for (const DistanceConstraint& c : rest.of(kind)) made.push_back({c.a, c.b});
+    std::vector<std::pair<ParticleIndex, ParticleIndex>> made, kept;
+    for (const DistanceConstraint& c : listed[static_cast<std::size_t>(kind)]) made.push_back({c.a, c.b});
+    for (const DistanceConstraint& c : rest.of(kind)) kept.push_back({std::min(c.a, c.b), std::max(c.a, c.b)});
+    std::vector<std::pair<ParticleIndex, ParticleIndex>> sorted = made;
+    for (auto& [a, b] : sorted) std::tie(a, b) = std::pair{std::min(a, b), std::max(a, b)};
+    std::sort(sorted.begin(), sorted.end());
+    std::sort(kept.begin(), kept.end());
+    EXPECT_EQ(kept, sorted) << name(kind);
     return made;
   };
   using Pairs = std::vector<std::pair<ParticleIndex, ParticleIndex>>;

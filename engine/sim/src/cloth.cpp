@@ -103,6 +103,7 @@ ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection) 
     rest.triangles.push_back(t);
   }
   rest.constraints = meshConstraints(rest, rest.triangles, mesh.nodes, selection);
+  orderConstraints(rest);
   return rest;
 }
 

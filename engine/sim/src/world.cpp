@@ -22,6 +22,7 @@
 #include "solver/batches.hpp"
 #include "solver/force_model.hpp"
 #include "solver/lines.hpp"
+#include "solver/pair_order.hpp"
 #include "solver/position_model.hpp"
 #include "solver/solver_scratch.hpp"
 #include "solver/tethers.hpp"
@@ -381,17 +382,21 @@ void World::plan(std::size_t c) {
   SolverScratch& scratch = records_[c].work->solver;
   if (scratch.planVersion == topologyVersion_) return;
   if (settings_.solver.lines()) {
-    // The fast sweep's batches: the constraints are put in batch order, once per topology.
-    Cloth& cloth = records_[c].cloth;
-    // A torn cloth's constraints each name their recipe: the names move with them.
-    // The stretch constraints have none: the lines put them in line order and solve them (a loose
-    // one one by one).
-    const batches::Batches made =
-        batches::colour(cloth.rest, cloth.topology.built ? &cloth.topology.source : nullptr, false);
+    // The fast sweep's batches and lines, read off the constraints' one order (orderConstraints,
+    // which the cloth's came in or were put in when it changed): the plan reorders nothing.
+    const Cloth& cloth = records_[c].cloth;
+    // The stretch constraints have no batches: the lines solve them (a loose one one by one).
+    const batches::Batches made = batches::find(cloth.rest, false);
     scratch.batchStart = made.start;
     scratch.sequentialTail = made.sequentialTail;
     lines::build(cloth, scratch, workers_->threads());
+    scratch.sweepOrder = {};
   } else {
+    // The seed's sweep takes each kind by particle pair, however the lists are kept.
+    const Cloth& cloth = records_[c].cloth;
+    for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
+      scratch.sweepOrder[kind] = byParticlePair(cloth.rest.constraints[kind]);
+    }
     scratch.batchStart = {};
     scratch.lines = {};
     scratch.looseStretch.clear();
@@ -446,9 +451,9 @@ MemoryUse World::memoryUse() const {
                 bytes(s.sumVelocity) + bytes(s.contactCollider) + bytes(s.contactNormal) + bytes(s.contactOffset) +
                 bytes(s.contactDepth) + bytes(s.contactRub) + bytes(s.layerContacts) + bytes(s.lambda) +
                 bytes(s.bendingLambda) + bytes(s.looseStretch) + bytes(s.lineNormal) + bytes(s.lineUpper) +
-                bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart) + bytes(s.bendingFactor.stencils) +
-                bytes(s.bendingFactor.inverseMass) + bytes(s.bendingFactor.lower) + bytes(s.bendingFactor.work) +
-                bytes(s.bendingFactor.rank);
+                bytes(s.lineSolution) + bytes(s.lineStiff) + bytes(s.batchStart) + bytes(s.sweepOrder) +
+                bytes(s.bendingFactor.stencils) + bytes(s.bendingFactor.inverseMass) + bytes(s.bendingFactor.lower) +
+                bytes(s.bendingFactor.work) + bytes(s.bendingFactor.rank);
     m.tethers += bytes(s.tethers.run) + bytes(s.tethers.pin) + bytes(s.tethers.length);
     for (const SolverScratch::LineFamily& f : s.lines) {
       m.lines += bytes(f.start) + bytes(f.lambda) + bytes(f.taut) + bytes(f.order) + bytes(f.besideNext);
@@ -1009,6 +1014,7 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   Cloth& cloth = records_[c].cloth;
   const std::size_t n = cloth.state.position.size();
   cloth.stretchTension.clear();  // its links were split or re-pointed: the tension builds again
+  orderConstraints(cloth.rest, cloth.topology.built ? &cloth.topology.source : nullptr);
   if (!records_[c].work->held.empty()) records_[c].work->held.resize(n, 0);
   // A particle a cut put between two particles one finger holds is held by it too, where it lies.
   for (const ParticleInsert& in : inserted) {
@@ -1247,6 +1253,10 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   while (!fingers_.empty()) releaseFinger(fingers_.front().id);
   // Made apart and then moved in (which cannot throw): a failure to allocate leaves the world as
   // it was.
+  for (Cloth& cloth : cloths) {
+    // In the engine's one order, whatever order they were kept in (a hand-edited snapshot).
+    orderConstraints(cloth.rest, cloth.topology.built ? &cloth.topology.source : nullptr, &cloth.stretchTension);
+  }
   std::vector<ClothRecord> records;
   records.reserve(cloths.size());
   for (Cloth& cloth : cloths) records.emplace_back(std::move(cloth));

@@ -79,9 +79,9 @@ TEST(Lines, ALatticeIsRowsAndColumns) {
 
 TEST(Lines, TheStretchConstraintsAreKeptInLineOrderWhateverOrderTheyCameIn) {
   // The lines read their particles and rest lengths from the cloth's stretch constraints, which
-  // build puts in line order. A drawn cloth's irregular fill leaves some links loose; which depends
-  // on the order links are taken in, so build takes them in their particles' order: built again
-  // from any order (a snapshot's, or after the threads change), the lines come out the same.
+  // lines::order puts in line order. A drawn cloth's irregular fill leaves some links loose; which
+  // depends on the order links are taken in, so order takes them in their particles' order: put in
+  // order again from any order (a hand-edited snapshot's), the lines come out the same.
   WorldSettings settings = test::hangingSheet(4, 1, 1);
   mesh::OutlineMesh shape =
       mesh::meshOutline({{{0.0, 0.0}, {0.9, 0.1}, {0.7, 0.8}, {0.2, 0.6}, {0.4, 0.35}}, 0.07, 1.0});
@@ -109,19 +109,14 @@ TEST(Lines, TheStretchConstraintsAreKeptInLineOrderWhateverOrderTheyCameIn) {
     for (DistanceConstraint& c : stretch) {
       if (random() % 2) std::swap(c.a, c.b);
     }
+    lines::order(cloth.rest, nullptr, nullptr);
     SolverScratch again;
     lines::build(cloth, again, 1);
     const std::vector<DistanceConstraint>& rebuilt = cloth.rest.of(ConstraintKind::stretch);
     ASSERT_EQ(rebuilt.size(), built.size());
-    // The lines' links point along their lines; a loose one keeps the way it was given.
-    const std::size_t loose = built.size() - scratch.looseStretch.size();
-    for (std::size_t k = 0; k < built.size(); ++k) {
-      const auto ends = [&](const DistanceConstraint& c) {
-        return k < loose ? std::pair{c.a, c.b} : std::pair{std::min(c.a, c.b), std::max(c.a, c.b)};
-      };
-      ASSERT_EQ(ends(rebuilt[k]), ends(built[k])) << "trial " << trial << ", constraint " << k;
-      ASSERT_EQ(rebuilt[k].restLength, built[k].restLength) << "trial " << trial << ", constraint " << k;
-    }
+    // The same links in the same order, each the same way round: the lines' along their lines, a
+    // loose one from its lower particle.
+    EXPECT_EQ(rebuilt, built) << "trial " << trial;
     EXPECT_EQ(again.looseStretch, scratch.looseStretch);
     for (std::size_t f = 0; f < 2; ++f) EXPECT_EQ(again.lines[f].start, scratch.lines[f].start);
   }
@@ -348,9 +343,18 @@ TEST(Lines, ABentChainConvergesQuadratically) {
 
 TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
   World world(test::hangingSheet(17, 1, 1));
-  ClothRest rest = world.cloths()[0].rest;
-  const ClothRest before = rest;
-  const batches::Batches made = batches::colour(rest);
+  // The lattice's constraints, each kind shuffled: batch order from any order.
+  const ClothRest before = [&] {
+    ClothRest shuffled = world.cloths()[0].rest;
+    std::mt19937 random(3);
+    for (std::vector<DistanceConstraint>& constraints : shuffled.constraints) {
+      std::shuffle(constraints.begin(), constraints.end(), random);
+    }
+    return shuffled;
+  }();
+  ClothRest rest = before;
+  batches::order(rest);
+  const batches::Batches made = batches::find(rest);
   for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
     const std::vector<DistanceConstraint>& constraints = rest.constraints[kind];
     // The same constraints, reordered.
@@ -361,6 +365,7 @@ TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
     EXPECT_EQ(a, b);
+    EXPECT_NE(constraints, before.constraints[kind]);  // ordering moved them
     const std::vector<std::uint32_t>& start = made.start[kind];
     ASSERT_GE(start.size(), 2u);
     EXPECT_EQ(start.back(), constraints.size());
@@ -374,34 +379,35 @@ TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
       }
     }
   }
-  // Colouring what is already coloured changes nothing.
-  ClothRest again = rest;
-  batches::colour(again);
-  for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
-    for (std::size_t k = 0; k < rest.constraints[kind].size(); ++k) {
-      EXPECT_EQ(again.constraints[kind][k].a, rest.constraints[kind][k].a);
-      EXPECT_EQ(again.constraints[kind][k].b, rest.constraints[kind][k].b);
+  // From another order, each constraint either way round: the same order.
+  ClothRest other = world.cloths()[0].rest;
+  std::mt19937 random(8);
+  for (std::vector<DistanceConstraint>& constraints : other.constraints) {
+    std::shuffle(constraints.begin(), constraints.end(), random);
+    for (DistanceConstraint& c : constraints) {
+      if (random() % 2) std::swap(c.a, c.b);
     }
   }
-  // Without the stretch constraints (with lines, which order them): those stay as they came, with
-  // no batches, and the other kinds are coloured as before.
+  batches::order(other);
+  EXPECT_EQ(other.constraints, rest.constraints);
+  // Ordering what is already in order changes nothing, and finds the same batches.
+  ClothRest again = rest;
+  batches::order(again);
+  EXPECT_EQ(again.constraints, rest.constraints);
+  const batches::Batches found = batches::find(again);
+  EXPECT_EQ(found.start, made.start);
+  // Without the stretch constraints (the lines order those): they stay as they came, with no
+  // batches, and the other kinds are ordered as before.
   const std::size_t stretch = static_cast<std::size_t>(ConstraintKind::stretch);
-  const auto sameOrder = [](const std::vector<DistanceConstraint>& x, const std::vector<DistanceConstraint>& y) {
-    for (std::size_t k = 0; k < x.size(); ++k) {
-      if (x[k].a != y[k].a || x[k].b != y[k].b) return false;
-    }
-    return x.size() == y.size();
-  };
-  ASSERT_FALSE(sameOrder(rest.constraints[stretch], before.constraints[stretch]));  // colouring moves them
   ClothRest lined = before;
-  const batches::Batches others = batches::colour(lined, nullptr, false);
-  EXPECT_TRUE(sameOrder(lined.constraints[stretch], before.constraints[stretch]));
+  batches::order(lined, nullptr, false);
+  const batches::Batches others = batches::find(lined, false);
+  EXPECT_EQ(lined.constraints[stretch], before.constraints[stretch]);
   EXPECT_TRUE(others.start[stretch].empty());
   EXPECT_FALSE(others.sequentialTail[stretch]);
   for (const ConstraintKind kind : {ConstraintKind::shear, ConstraintKind::bend}) {
     EXPECT_EQ(others.start[static_cast<std::size_t>(kind)], made.start[static_cast<std::size_t>(kind)]);
-    EXPECT_TRUE(
-        sameOrder(lined.constraints[static_cast<std::size_t>(kind)], rest.constraints[static_cast<std::size_t>(kind)]));
+    EXPECT_EQ(lined.constraints[static_cast<std::size_t>(kind)], rest.constraints[static_cast<std::size_t>(kind)]);
   }
 }
 
@@ -455,7 +461,8 @@ TEST(Batches, AParticleWithMoreThan63ConstraintsGoesToASequentialTail) {
     rest.constraints[0].push_back({0, i, static_cast<RestReal>(i)});
   }
   rest.setRestPositions(positions);
-  const batches::Batches made = batches::colour(rest);
+  batches::order(rest);
+  const batches::Batches made = batches::find(rest);
   EXPECT_TRUE(made.sequentialTail[0]);
   EXPECT_EQ(made.start[0].size() - 1, 64u);  // 63 batches of one, and the tail
   EXPECT_EQ(made.start[0][63], 63u);
@@ -885,6 +892,7 @@ Cloth threeLinksAlongX() {
   cloth.state.inverseMass.assign(4, 1.0);
   cloth.state.mass.assign(4, 1.0);
   cloth.state.pinned.assign(4, 0);
+  orderConstraints(cloth.rest);
   return cloth;
 }
 

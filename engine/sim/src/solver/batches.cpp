@@ -4,34 +4,89 @@
 #include <bit>
 
 #include "invariant.hpp"
+#include "solver/pair_order.hpp"
 
 namespace drape::sim::batches {
 
-Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source, bool stretchToo) {
+namespace {
+
+// One kind's constraints coloured greedily in the order they come: each takes the first colour
+// neither of its particles has yet (colour 63, the sequential tail, is never marked used).
+struct Colouring {
+  std::vector<std::uint8_t> colourOf;
+  std::array<std::uint32_t, kColours + 1> count{};  // count[c + 1]: constraints of colour c
+};
+
+Colouring colourAll(const std::vector<DistanceConstraint>& constraints, std::size_t particles) {
+  Colouring result;
+  std::vector<std::uint64_t> used(particles, 0);
+  result.colourOf.resize(constraints.size());
+  for (std::size_t k = 0; k < constraints.size(); ++k) {
+    const DistanceConstraint& c = constraints[k];
+    const std::uint64_t taken = used[c.a] | used[c.b];
+    const std::uint32_t colour =
+        std::min<std::uint32_t>(static_cast<std::uint32_t>(std::countr_one(taken)), kColours - 1);
+    if (colour < kColours - 1) {
+      used[c.a] |= std::uint64_t{1} << colour;
+      used[c.b] |= std::uint64_t{1} << colour;
+    }
+    result.colourOf[k] = static_cast<std::uint8_t>(colour);
+    ++result.count[colour + 1];
+  }
+  return result;
+}
+
+bool skipped(std::size_t kind, bool stretchToo) {
+  return !stretchToo && kind == static_cast<std::size_t>(ConstraintKind::stretch);
+}
+
+}  // namespace
+
+void order(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source, bool stretchToo) {
+  for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
+    if (skipped(kind, stretchToo)) continue;
+    std::vector<DistanceConstraint>& constraints = rest.constraints[kind];
+    // First by particle pair, each from its lower particle: so the order does not depend on the
+    // order they came in, nor on which way round each was given.
+    const std::vector<std::uint32_t> byPair = byParticlePair(constraints);
+    std::vector<DistanceConstraint> paired(constraints.size());
+    for (std::size_t k = 0; k < byPair.size(); ++k) {
+      const DistanceConstraint& c = constraints[byPair[k]];
+      paired[k] = {std::min(c.a, c.b), std::max(c.a, c.b), c.restLength};
+    }
+    // Then coloured in that order, and put in runs by colour, in that order within a run.
+    Colouring colouring = colourAll(paired, rest.particleCount());
+    std::array<std::uint32_t, kColours + 1>& fill = colouring.count;
+    for (std::uint32_t c = 0; c < kColours; ++c) fill[c + 1] += fill[c];
+    std::vector<std::uint32_t> from(constraints.size());  // where each ends up came from
+    for (std::size_t k = 0; k < paired.size(); ++k) {
+      const std::uint32_t to = fill[colouring.colourOf[k]]++;
+      constraints[to] = paired[k];
+      from[to] = byPair[k];
+    }
+    if (source && (*source)[kind].size() == from.size()) {
+      std::vector<std::uint32_t> moved(from.size());
+      for (std::size_t k = 0; k < from.size(); ++k) moved[k] = (*source)[kind][from[k]];
+      (*source)[kind].swap(moved);
+    }
+  }
+}
+
+Batches find(const ClothRest& rest, bool stretchToo) {
   Batches result;
   const std::size_t n = rest.particleCount();
-  std::vector<std::uint64_t> used(n);
-  std::vector<std::uint8_t> colourOf;
-  std::vector<DistanceConstraint> sorted;
   for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
-    if (!stretchToo && kind == static_cast<std::size_t>(ConstraintKind::stretch)) continue;
-    std::vector<DistanceConstraint>& constraints = rest.constraints[kind];
-    std::fill(used.begin(), used.end(), 0);
-    colourOf.resize(constraints.size());
-    std::array<std::uint32_t, kColours + 1> count{};
-    for (std::size_t k = 0; k < constraints.size(); ++k) {
-      const DistanceConstraint& c = constraints[k];
-      const std::uint64_t taken = used[c.a] | used[c.b];
-      // Colour 63 is the sequential tail: it is never marked used.
-      const std::uint32_t colour =
-          std::min<std::uint32_t>(static_cast<std::uint32_t>(std::countr_one(taken)), kColours - 1);
-      if (colour < kColours - 1) {
-        used[c.a] |= std::uint64_t{1} << colour;
-        used[c.b] |= std::uint64_t{1} << colour;
-      }
-      colourOf[k] = static_cast<std::uint8_t>(colour);
-      ++count[colour + 1];
+    if (skipped(kind, stretchToo)) continue;
+    const std::vector<DistanceConstraint>& constraints = rest.constraints[kind];
+    // Coloured again in the order they are in, each keeps its colour (order is stable within a
+    // colour, and a constraint's colour depends only on those before it of lower colour): so the
+    // colours come in runs.
+    Colouring colouring = colourAll(constraints, n);
+    if constexpr (kCheckInvariants) {
+      DRAPE_INVARIANT(std::is_sorted(colouring.colourOf.begin(), colouring.colourOf.end()),
+                      "the constraints are in batch order (orderConstraints)");
     }
+    std::array<std::uint32_t, kColours + 1>& count = colouring.count;
     for (std::uint32_t c = 0; c < kColours; ++c) count[c + 1] += count[c];
     std::vector<std::uint32_t>& start = result.start[kind];
     start.assign(1, 0);
@@ -39,14 +94,6 @@ Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstrai
       if (count[c] != start.back()) start.push_back(count[c]);  // empty colours make no batch
     }
     result.sequentialTail[kind] = count[kColours] != count[kColours - 1];
-    sorted.resize(constraints.size());
-    std::array<std::uint32_t, kColours + 1> fill = count;
-    std::vector<std::uint32_t> to(constraints.size());
-    for (std::size_t k = 0; k < constraints.size(); ++k) {
-      to[k] = fill[colourOf[k]]++;
-      sorted[to[k]] = constraints[k];
-    }
-    constraints.swap(sorted);
     if constexpr (kCheckInvariants) {
       // What lets a batch be shared among threads: no particle twice in it (but the tail).
       std::vector<std::uint32_t> lastBatch(n, UINT32_MAX);
@@ -59,11 +106,6 @@ Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstrai
           }
         }
       }
-    }
-    if (source && (*source)[kind].size() == to.size()) {
-      std::vector<std::uint32_t> moved(to.size());
-      for (std::size_t k = 0; k < to.size(); ++k) moved[to[k]] = (*source)[kind][k];
-      (*source)[kind].swap(moved);
     }
   }
   return result;

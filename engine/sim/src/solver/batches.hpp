@@ -1,4 +1,4 @@
-// Batches: each kind's constraints reordered so that they come in runs ("batches") no two of
+// Batches: each kind's constraints in an order where they come in runs ("batches") no two of
 // whose constraints share a particle (greedy graph colouring). Within a batch the order does not
 // matter, so a batch can be cut among threads and still give the same result bit for bit; and
 // consecutive constraints never wait on each other, so even one core overlaps their square roots
@@ -24,12 +24,18 @@ struct Batches {
   std::array<bool, kConstraintKindCount> sequentialTail{};
 };
 
-// Reorders rest.constraints in place (stable within a batch) and returns the batches. Applying it
-// to constraints it has already ordered changes nothing. `source`, if given (a torn cloth's
-// Topology::source: per constraint, the recipe it came from), is reordered along with them.
-// Without `stretchToo` the stretch constraints are left as they are, with no batches (the lines
-// order and solve them).
-Batches colour(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source = nullptr,
-               bool stretchToo = true);
+// Puts each kind's constraints in batch order, in place, the stretch constraints only with
+// `stretchToo`: by particle pair (each turned to run from its lower particle), coloured greedily in
+// that order, then in runs by colour, by pair within a run. So the order depends only on which
+// constraints there are, not on the order they came in. Part of the one order a cloth's constraints
+// are kept in (orderConstraints, cloth.hpp; it leaves stretch to the lines). Putting them in order
+// again changes nothing. `source`, if given (a torn cloth's Topology::source: per constraint, the
+// recipe it came from), moves with them.
+void order(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source = nullptr,
+           bool stretchToo = true);
+
+// The batches of constraints already in batch order (order): each kind's, the stretch
+// constraints' only with `stretchToo` (else none).
+Batches find(const ClothRest& rest, bool stretchToo = true);
 
 }  // namespace drape::sim::batches

@@ -11,6 +11,7 @@
 
 #include "invariant.hpp"
 #include "solver/lines_wide.hpp"
+#include "solver/pair_order.hpp"
 #include "solver/position_model.hpp"
 #include "solver/stiff_lanes.hpp"
 
@@ -332,36 +333,41 @@ bool cpuHasAvx() {
 #endif
 }
 
-void build(Cloth& cloth, SolverScratch& scratch, int threads) {
-  std::vector<DistanceConstraint>& stretch = cloth.rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
-  const std::size_t n = cloth.rest.particleCount();
-  // The links are taken in the order of their particles, not of the array: which join a line then
-  // does not depend on the order the constraints come in, so building again from the order this
-  // leaves them in (a snapshot, another thread count) gives the same lines.
-  std::vector<std::uint32_t> byPair(stretch.size());
-  std::iota(byPair.begin(), byPair.end(), 0u);
-  const auto pair = [&](std::uint32_t k) {
-    const DistanceConstraint& c = stretch[k];
-    return std::pair{std::min(c.a, c.b), std::max(c.a, c.b)};
-  };
-  std::stable_sort(byPair.begin(), byPair.end(), [&](std::uint32_t l, std::uint32_t r) { return pair(l) < pair(r); });
+namespace {
+
+// The lines a cloth's stretch constraints make (build's rule, lines.hpp), walked from one end of
+// each: per family its lines' starts, and every link in line order, each turned to point along its
+// line, then the loose ones.
+struct Walk {
+  std::array<std::vector<std::uint32_t>, 2> start;  // per family, as LineFamily::start
+  std::array<std::uint32_t, 2> linkBase{};
   std::vector<DistanceConstraint> ordered;  // the links of the lines, line by line; then the loose
-  ordered.reserve(stretch.size());
-  std::vector<std::uint32_t> from;  // where each came from
-  from.reserve(stretch.size());
+  std::vector<std::uint32_t> from;          // where each came from in the stretch constraints
+  std::vector<std::uint32_t> loose;         // the loose ones' places in `ordered`
+  std::size_t longest = 0;                  // particles of the longest line
+};
+
+Walk walk(const ClothRest& rest) {
+  const std::vector<DistanceConstraint>& stretch = rest.of(ConstraintKind::stretch);
+  const std::size_t n = rest.particleCount();
+  Walk w;
+  // The links are taken in the order of their particles, not of the array: which join a line then
+  // does not depend on the order the constraints come in, so walking again the order this gives
+  // them gives the same lines.
+  const std::vector<std::uint32_t> byPair = byParticlePair(stretch);
+  w.ordered.reserve(stretch.size());
+  w.from.reserve(stretch.size());
   std::array<std::vector<std::uint32_t>, 2> loose;
-  std::size_t longest = 0;
   for (int family = 0; family < 2; ++family) {
-    SolverScratch::LineFamily& lines = scratch.lines[static_cast<std::size_t>(family)];
-    lines = {};
-    lines.linkBase = static_cast<std::uint32_t>(ordered.size());
+    std::vector<std::uint32_t>& starts = w.start[static_cast<std::size_t>(family)];
+    w.linkBase[static_cast<std::size_t>(family)] = static_cast<std::uint32_t>(w.ordered.size());
     std::vector<std::uint8_t> degree(n, 0);
     std::vector<std::uint32_t> parent(n);
     std::iota(parent.begin(), parent.end(), 0u);
     std::vector<std::array<std::int64_t, 2>> next(n, {-1, -1});  // the constraints at each particle
     for (const std::uint32_t k : byPair) {
       const DistanceConstraint& c = stretch[k];
-      const Vec3 d = glm::abs(cloth.rest.restPosition(c.b) - cloth.rest.restPosition(c.a));
+      const Vec3 d = glm::abs(rest.restPosition(c.b) - rest.restPosition(c.a));
       const bool alongX = d.x >= std::max(d.y, d.z);
       if (alongX != (family == 0)) continue;
       const std::uint32_t ra = findRoot(parent, c.a), rb = findRoot(parent, c.b);
@@ -376,10 +382,10 @@ void build(Cloth& cloth, SolverScratch& scratch, int threads) {
     // Walk each line from one of its ends, turning each link to point along it.
     std::vector<std::uint8_t> done(n, 0);
     std::uint32_t slots = 0;
-    for (std::size_t start = 0; start < n; ++start) {
-      if (degree[start] != 1 || done[start]) continue;
-      lines.start.push_back(slots);
-      std::size_t at = start;
+    for (std::size_t first = 0; first < n; ++first) {
+      if (degree[first] != 1 || done[first]) continue;
+      starts.push_back(slots);
+      std::size_t at = first;
       std::int64_t previous = -1;
       std::size_t length = 0;
       while (true) {
@@ -393,41 +399,68 @@ void build(Cloth& cloth, SolverScratch& scratch, int threads) {
         if (link < 0) break;
         DistanceConstraint c = stretch[static_cast<std::size_t>(link)];
         if (c.a != at) std::swap(c.a, c.b);
-        ordered.push_back(c);
-        from.push_back(static_cast<std::uint32_t>(link));
+        w.ordered.push_back(c);
+        w.from.push_back(static_cast<std::uint32_t>(link));
         at = c.b;
         previous = link;
       }
-      longest = std::max(longest, length);
+      w.longest = std::max(w.longest, length);
     }
-    lines.start.push_back(slots);
+    starts.push_back(slots);
   }
-  scratch.looseStretch.clear();
   for (const std::vector<std::uint32_t>& family : loose) {
     for (const std::uint32_t k : family) {
-      scratch.looseStretch.push_back(static_cast<std::uint32_t>(ordered.size()));
-      ordered.push_back(stretch[k]);
-      from.push_back(k);
+      w.loose.push_back(static_cast<std::uint32_t>(w.ordered.size()));
+      const DistanceConstraint& c = stretch[k];
+      w.ordered.push_back({std::min(c.a, c.b), std::max(c.a, c.b), c.restLength});  // from its lower particle
+      w.from.push_back(k);
     }
   }
-  // A torn cloth's constraints each name their recipe: the names move with them.
-  std::vector<std::uint32_t>& source = cloth.topology.source[static_cast<std::size_t>(ConstraintKind::stretch)];
-  if (cloth.topology.built && source.size() == from.size()) {
-    std::vector<std::uint32_t> moved(from.size());
-    for (std::size_t k = 0; k < from.size(); ++k) moved[k] = source[from[k]];
-    source.swap(moved);
+  return w;
+}
+
+// Moves values kept one a stretch constraint as the constraints move (to[k] came from from[k]).
+template <class T>
+void follow(std::vector<T>& values, const std::vector<std::uint32_t>& from) {
+  std::vector<T> moved(from.size());
+  for (std::size_t k = 0; k < from.size(); ++k) moved[k] = values[from[k]];
+  values.swap(moved);
+}
+
+}  // namespace
+
+void order(ClothRest& rest, std::vector<std::uint32_t>* source, std::vector<float>* tension) {
+  Walk w = walk(rest);
+  if (source && source->size() == w.from.size()) follow(*source, w.from);
+  // A tension that is not one a constraint is stale: none.
+  if (tension) {
+    if (tension->size() == w.from.size()) {
+      follow(*tension, w.from);
+    } else {
+      tension->clear();
+    }
   }
-  // The tension moves with its constraints too (a snapshot's comes in the order this leaves them
-  // in, and goes on as it was); if it is not one a constraint, it is stale: none.
-  std::vector<float>& tension = cloth.stretchTension;
-  if (tension.size() == from.size()) {
-    std::vector<float> moved(from.size());
-    for (std::size_t k = 0; k < from.size(); ++k) moved[k] = tension[from[k]];
-    tension.swap(moved);
-  } else {
-    tension.clear();
+  rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)].swap(w.ordered);
+}
+
+void build(const Cloth& cloth, SolverScratch& scratch, int threads) {
+  const std::vector<DistanceConstraint>& stretch = cloth.rest.of(ConstraintKind::stretch);
+  Walk w = walk(cloth.rest);
+  if constexpr (kCheckInvariants) {
+    // The order the lines read: the one order (orderConstraints) already, each link turned.
+    for (std::size_t k = 0; k < stretch.size(); ++k) {
+      DRAPE_INVARIANT(w.from[k] == k && w.ordered[k] == stretch[k],
+                      "the stretch constraints are in line order (orderConstraints)");
+    }
   }
-  stretch.swap(ordered);
+  for (std::size_t family = 0; family < 2; ++family) {
+    SolverScratch::LineFamily& lines = scratch.lines[family];
+    lines = {};
+    lines.start = std::move(w.start[family]);
+    lines.linkBase = w.linkBase[family];
+  }
+  scratch.looseStretch = std::move(w.loose);
+  const std::size_t longest = w.longest;
   for (SolverScratch::LineFamily& lines : scratch.lines) {
     const std::size_t count = lines.start.size() - 1;
     if constexpr (kCheckInvariants) {

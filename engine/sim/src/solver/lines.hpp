@@ -24,15 +24,23 @@ namespace drape::sim::lines {
 // not built with them.
 bool cpuHasAvx();
 
-// Rebuilds scratch.lines and scratch.looseStretch from the cloth's stretch constraints. A link
-// goes to the family of its rest direction (along x, or not) and joins a line there unless that
-// would give a particle three links in the family or close a loop (the links taken in the order of
-// their particles); then it is loose. The lines read their particles and rest lengths from the
-// constraints, which this puts in line order: the rows' links line by line, then the columns',
-// then the loose ones; each line's link k from its particle k (a) to k + 1 (b). A torn cloth's
-// recipe names (topology.source) and the links' tension (Cloth::stretchTension, where it has one a
-// link) move with them.
-void build(Cloth& cloth, SolverScratch& scratch, int threads);
+// The lines a cloth's stretch constraints make: a link goes to the family of its rest direction
+// (along x, or not) and joins a line there unless that would give a particle three links in the
+// family or close a loop (the links taken in the order of their particles, so the lines do not
+// depend on the order the constraints come in); then it is loose. Line order: the rows' links line
+// by line, then the columns', then the loose ones (each from its lower particle); each line's link k
+// from its particle k (a) to k + 1 (b). It depends only on which links there are, not on the order
+// they came in or which way round.
+//
+// Puts the stretch constraints in line order: part of the one order a cloth's constraints are kept
+// in (orderConstraints, cloth.hpp), whichever solver runs. `source` (a torn cloth's recipe names,
+// Topology::source) and `tension` (Cloth::stretchTension, where it has one a link; else it is
+// stale and emptied) move with them. Putting them in order again changes nothing.
+void order(ClothRest& rest, std::vector<std::uint32_t>* source, std::vector<float>* tension);
+
+// Rebuilds scratch.lines and scratch.looseStretch from the cloth's stretch constraints, which must
+// be in line order already (order): the lines read their particles and rest lengths there.
+void build(const Cloth& cloth, SolverScratch& scratch, int threads);
 
 // One Newton step of every line's projection from where its particles are now: the rows, then the
 // columns. `stiffness` scales each correction (position model); with `xpbd`, alphaTilde =

@@ -3,6 +3,7 @@
 #include "drape/sim/metrics.hpp"
 
 #include "collision/contacts.hpp"
+#include "invariant.hpp"
 #include "solver/aerodynamics.hpp"
 #include "solver/bending.hpp"
 #include "solver/distance_wide.hpp"
@@ -394,7 +395,8 @@ Stage partOf(ConstraintKind kind) {
 }
 
 // The seed's sweep: a fabric's bend stencils, then every kind in order (stretch, shear, bend), each
-// constraint after the one before it in the order the cloth lists them, then the tethers. One thread.
+// constraint after the one before it by particle pair (SolverScratch::sweepOrder), then the tethers.
+// One thread.
 void sweepInOrder(Cloth& cloth, const Compliances& compliances, SolverScratch& scratch, PartClock& parts) {
   ParticleState& s = cloth.state;
   const bool xpbd = compliances.xpbd;
@@ -403,13 +405,19 @@ void sweepInOrder(Cloth& cloth, const Compliances& compliances, SolverScratch& s
   for (ConstraintKind kind : kConstraintKinds) {
     const KindMaterial& material = cloth.settings.material(kind);
     if (material.stiffness == 0.0) continue;
-    const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
+    const DistanceConstraint* constraints = cloth.rest.of(kind).data();
+    const std::vector<std::uint32_t>& order = scratch.sweepOrder[static_cast<std::size_t>(kind)];
+    DRAPE_INVARIANT(order.size() == cloth.rest.of(kind).size(), "the sweep's order was planned");
     parts.time(partOf(kind), [&] {
       if (xpbd) {
-        projectCompliantRange(s, constraints.data(), scratch.lambda[static_cast<std::size_t>(kind)].data(), 0,
-                              constraints.size(), compliances.kind[static_cast<std::size_t>(kind)]);
+        Real* lambda = scratch.lambda[static_cast<std::size_t>(kind)].data();
+        const Real alphaTilde = compliances.kind[static_cast<std::size_t>(kind)];
+        for (const std::uint32_t k : order) {
+          projectCompliant(s.position, s.previousPosition, s.inverseMass, constraints[k], alphaTilde, lambda[k]);
+        }
       } else {
-        projectRange(s, constraints.data(), 0, constraints.size(), material.stiffness);
+        for (const std::uint32_t k : order)
+          projectDistance(s.position, s.inverseMass, constraints[k], material.stiffness);
       }
     });
   }

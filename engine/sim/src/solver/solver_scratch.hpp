@@ -94,9 +94,9 @@ struct SolverScratch {
   Tethers tethers;
   // Lines (the lines stretch solver): the stretch constraints as chains, rows and columns on a lattice, each
   // solved at once (lines.hpp). Built from the constraints whenever they change. A line keeps no
-  // copy of its particles or rest lengths: lines::build puts the cloth's stretch constraints in line
-  // order, each line's links one after another and each link from the line's particle k (its a)
-  // to k + 1 (its b), so the line reads them there.
+  // copy of its particles or rest lengths: a cloth keeps its stretch constraints in line order
+  // (orderConstraints, lines::order), each line's links one after another and each link from the
+  // line's particle k (its a) to k + 1 (its b), so the line reads them there.
   struct LineFamily {
     // Line l has start[l + 1] - start[l] particles, and a slot for each in the per-link arrays
     // below (lambda, tension): link k of the line (k < its particles - 1) is slot start[l] + k.
@@ -164,6 +164,10 @@ struct SolverScratch {
   // [batchStart[b], batchStart[b + 1]); with sequentialTail the last batch is not one.
   std::array<std::vector<std::uint32_t>, kConstraintKindCount> batchStart;
   std::array<bool, kConstraintKindCount> sequentialTail{};
+  // The seed's sweep (gauss-seidel): each kind's constraints in the order it takes them, by particle
+  // pair (the lower first), as a lattice lists them by lattice position and a tear rebuilds them:
+  // indices into the cloth's lists, which keep the lines' and batches' order (orderConstraints).
+  std::array<std::vector<std::uint32_t>, kConstraintKindCount> sweepOrder;
   std::uint64_t planVersion = 0;    // the world's topology version the batches and lines were made for
   std::int64_t extraLineSteps = 0;  // line steps taken beyond a sweep's two (solver.maxStretch)
 };

@@ -10,6 +10,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "solver/pair_order.hpp"
+
 namespace drape::sim::topology {
 
 namespace {
@@ -1511,19 +1513,28 @@ void relax(Cloth& cloth, const std::vector<ParticleIndex>& from) {
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   std::vector<Vec3> normalBefore(touched.size());
   for (std::size_t k = 0; k < touched.size(); ++k) normalBefore[k] = normalOf(rest.triangles[touched[k]]);
+  // The links with an end inside, stretch then shear, each kind's by particle pair (pair_order.hpp)
+  // as the seed's sweep takes them, whatever order the cloth keeps them in.
+  std::vector<DistanceConstraint> links;
+  for (const ConstraintKind kind : {ConstraintKind::stretch, ConstraintKind::shear}) {
+    const std::vector<DistanceConstraint>& all = rest.of(kind);
+    std::vector<std::uint32_t> near;
+    for (std::uint32_t k = 0; k < all.size(); ++k) {
+      if (inside[all[k].a] || inside[all[k].b]) near.push_back(k);
+    }
+    sortByPair(near, all);
+    for (const std::uint32_t k : near) links.push_back(all[k]);
+  }
   for (int sweep = 0; sweep < kRelaxSweeps; ++sweep) {
-    for (const ConstraintKind kind : {ConstraintKind::stretch, ConstraintKind::shear}) {
-      for (const DistanceConstraint& c : rest.of(kind)) {
-        if (!inside[c.a] && !inside[c.b]) continue;
-        const Real wa = s.inverseMass[c.a], wb = s.inverseMass[c.b];
-        if (!(wa + wb > 0.0)) continue;
-        const Vec3 d = s.position[c.b] - s.position[c.a];
-        const Real length = glm::length(d);
-        if (!(length > 0.0)) continue;
-        const Vec3 correction = (length - static_cast<Real>(c.restLength)) / (length * (wa + wb)) * d;
-        s.position[c.a] += wa * correction;
-        s.position[c.b] -= wb * correction;
-      }
+    for (const DistanceConstraint& c : links) {
+      const Real wa = s.inverseMass[c.a], wb = s.inverseMass[c.b];
+      if (!(wa + wb > 0.0)) continue;
+      const Vec3 d = s.position[c.b] - s.position[c.a];
+      const Real length = glm::length(d);
+      if (!(length > 0.0)) continue;
+      const Vec3 correction = (length - static_cast<Real>(c.restLength)) / (length * (wa + wb)) * d;
+      s.position[c.a] += wa * correction;
+      s.position[c.b] -= wb * correction;
     }
   }
   // Each round puts back at least one particle (a triangle whose corners are all back is as it

@@ -29,6 +29,7 @@ struct DistanceConstraint {
   ParticleIndex a;
   ParticleIndex b;
   RestReal restLength;  // m
+  bool operator==(const DistanceConstraint&) const = default;
 };
 
 // A rest length as the engine keeps it (RestReal). Throws std::invalid_argument where `length` is
@@ -135,21 +136,33 @@ struct LatticeMesh {
 // particle exist and the two are not joined by an edge themselves. A mesh without triangles is a
 // chain: its edges are the lattice's row and column neighbours. Rest lengths are measured on the
 // rest positions as rounded (ClothRest::setRestPositions); an edge between particles that coincide
-// there gets no constraint. The lists are in lattice order: stretch by particle pair (a < b), shear
-// by cell, row by row, its diagonal (column, row)-(column + 1, row + 1) first, bend by first node,
-// row by row, along the row first. Border triangles without a lattice bend across them get no extra
+// there gets no constraint. The lists come in the engine's one order (orderConstraints). Border
+// triangles without a lattice bend across them get no extra
 // bending constraint. Throws std::invalid_argument where the mesh is not one: nodes not one per
 // particle, a node off the lattice (negative) or stood for twice, a triangle with a corner out of
 // range or twice, a position not finite.
 ClothRest constrainMesh(const LatticeMesh& mesh, ConstraintSelection selection = {});
 // The rules constrainMesh makes a mesh's constraints by, over `triangles` of a cloth whose rest
 // positions `rest` has, each particle standing for lattice node nodes[p] (or kNoNode; one a
-// particle): what constrainMesh puts in its lists. Tearing makes the links of the edges a split
+// particle): what constrainMesh puts in its lists, in lattice order: stretch by particle pair
+// (a < b), shear by cell, row by row, its diagonal (column, row)-(column + 1, row + 1) first, bend
+// by first node, row by row, along the row first. Tearing makes the links of the edges a split
 // triangle's children add so (topology.cpp): a particle it inserts stands for no node, so each such
 // edge is stretch. Throws std::invalid_argument as constrainMesh does.
 std::array<std::vector<DistanceConstraint>, kConstraintKindCount> meshConstraints(
     const ClothRest& rest, const std::vector<glm::uvec3>& triangles, const std::vector<glm::ivec2>& nodes,
     ConstraintSelection selection = {});
+
+// Puts a cloth's constraints in the one order the engine keeps them in, whichever solver runs:
+// stretch in line order (the rows' links line by line, each turned to point along its row, then the
+// columns', then the links on no line), shear and bend each in batches no two of whose constraints
+// share a particle (so a batch can be shared among threads). constrainMesh's lists come in it; the
+// world puts a cloth's in it as the cloth enters and as it is torn or cut; no solver reorders them.
+// Putting them in it again changes nothing. `source` (a torn cloth's Topology::source: per
+// constraint, the recipe it came from) and `stretchTension` (Cloth::stretchTension) move with
+// them where they have one entry a constraint; a tension that has not is stale, and emptied.
+void orderConstraints(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source = nullptr,
+                      std::vector<float>* stretchTension = nullptr);
 
 // Builds the lattice (by constrainMesh). Throws std::invalid_argument if the spec is not a valid
 // lattice.
