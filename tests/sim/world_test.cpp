@@ -361,7 +361,7 @@ TEST(World, KeepsAClothsConstraintsInOneOrderWhicheverSolverRuns) {
   World bySeed(seed), byLines(lined);
   const auto made = byLines.cloths()[0].rest.constraints;
   EXPECT_EQ(bySeed.cloths()[0].rest.constraints, made);
-  // Planned for lines, on one thread and on two, switched to the seed's sweep and back, torn.
+  // Planned for lines, on one thread and on two, switched to the seed's sweep and back.
   byLines.run(10);
   EXPECT_EQ(byLines.cloths()[0].rest.constraints, made);
   byLines.setThreads(2);

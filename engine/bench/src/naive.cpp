@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -21,7 +23,17 @@ NaiveCloth::NaiveCloth(const sim::WorldSettings& world, int iterations)
   for (sim::ConstraintKind kind : sim::kConstraintKinds) {
     const sim::Real stiffness = cloth.material(kind).stiffness;
     if (stiffness == 0.0) continue;
-    for (const sim::DistanceConstraint& c : rest.of(kind)) {
+    // In lattice order: by particle pair, each from its lower particle (the engine keeps its lists
+    // in an order of its own, sim::orderConstraints).
+    std::vector<sim::DistanceConstraint> lattice = rest.of(kind);
+    for (sim::DistanceConstraint& c : lattice) {
+      if (c.b < c.a) std::swap(c.a, c.b);
+    }
+    std::stable_sort(lattice.begin(), lattice.end(),
+                     [](const sim::DistanceConstraint& l, const sim::DistanceConstraint& r) {
+                       return std::pair{l.a, l.b} < std::pair{r.a, r.b};
+                     });
+    for (const sim::DistanceConstraint& c : lattice) {
       constraints_.push_back({static_cast<int>(c.a), static_cast<int>(c.b), c.restLength, stiffness});
     }
     if (kind == sim::ConstraintKind::stretch) structural_ = constraints_.size();

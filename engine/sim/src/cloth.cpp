@@ -313,7 +313,7 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
     other[fill[c.a]++] = c.b;
     other[fill[c.b]++] = c.a;
   }
-  // By particle, not by the links' order (which planning changes with the thread count).
+  // By particle, not by the order the links are kept in.
   for (std::size_t i = 0; i < n; ++i) std::sort(other.begin() + start[i], other.begin() + start[i + 1]);
   constexpr Real kOpposite = -0.99;  // cos 172 degrees
   std::vector<BendStencil> stencils;

@@ -642,7 +642,7 @@ void World::positionSubstep(Real h) {
       contact::clampTravel(record.cloth, settings_.selfCollision.maxTravel * settings_.selfCollision.distance);
   });
   timed(Stage::dampConstraints, [&](PartClock&) {
-    for (ClothRecord& record : records_) position::dampConstraints(record.cloth);
+    for (ClothRecord& record : records_) position::dampConstraints(record.cloth, record.work->solver);
   });
 }
 

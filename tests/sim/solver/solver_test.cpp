@@ -353,8 +353,8 @@ TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
     return shuffled;
   }();
   ClothRest rest = before;
-  batches::order(rest);
-  const batches::Batches made = batches::find(rest);
+  batches::order(rest, nullptr, true);
+  const batches::Batches made = batches::find(rest, true);
   for (std::size_t kind = 0; kind < kConstraintKindCount; ++kind) {
     const std::vector<DistanceConstraint>& constraints = rest.constraints[kind];
     // The same constraints, reordered.
@@ -388,13 +388,13 @@ TEST(Batches, NoTwoConstraintsOfABatchShareAParticle) {
       if (random() % 2) std::swap(c.a, c.b);
     }
   }
-  batches::order(other);
+  batches::order(other, nullptr, true);
   EXPECT_EQ(other.constraints, rest.constraints);
   // Ordering what is already in order changes nothing, and finds the same batches.
   ClothRest again = rest;
-  batches::order(again);
+  batches::order(again, nullptr, true);
   EXPECT_EQ(again.constraints, rest.constraints);
-  const batches::Batches found = batches::find(again);
+  const batches::Batches found = batches::find(again, true);
   EXPECT_EQ(found.start, made.start);
   // Without the stretch constraints (the lines order those): they stay as they came, with no
   // batches, and the other kinds are ordered as before.
@@ -461,8 +461,8 @@ TEST(Batches, AParticleWithMoreThan63ConstraintsGoesToASequentialTail) {
     rest.constraints[0].push_back({0, i, static_cast<RestReal>(i)});
   }
   rest.setRestPositions(positions);
-  batches::order(rest);
-  const batches::Batches made = batches::find(rest);
+  batches::order(rest, nullptr, true);
+  const batches::Batches made = batches::find(rest, true);
   EXPECT_TRUE(made.sequentialTail[0]);
   EXPECT_EQ(made.start[0].size() - 1, 64u);  // 63 batches of one, and the tail
   EXPECT_EQ(made.start[0][63], 63u);
@@ -1198,7 +1198,8 @@ TEST(Tethers, NoneReachesAcrossACut) {
 TEST(FastSweep, ASecondTearOfAChainBreaksTheLinkThatIsPulled) {
   // A chain of 12 particles 10 cm apart between two pins, soft enough to be pulled past the tearing
   // threshold. Particle 3 is pulled aside: a link at it tears. Then particle 8: a link at it must
-  // tear (the constraints, reordered into batches, keep naming the recipes they came from).
+  // tear (the constraints, put in order again after the first tear, keep naming the recipes they
+  // came from).
   WorldSettings settings;
   settings.solver.stretchSolver = StretchSolver::lines;
   settings.solver.iterations = 1;

@@ -31,11 +31,10 @@ struct Batches {
 // are kept in (orderConstraints, cloth.hpp; it leaves stretch to the lines). Putting them in order
 // again changes nothing. `source`, if given (a torn cloth's Topology::source: per constraint, the
 // recipe it came from), moves with them.
-void order(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source = nullptr,
-           bool stretchToo = true);
+void order(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKindCount>* source, bool stretchToo);
 
 // The batches of constraints already in batch order (order): each kind's, the stretch
 // constraints' only with `stretchToo` (else none).
-Batches find(const ClothRest& rest, bool stretchToo = true);
+Batches find(const ClothRest& rest, bool stretchToo);
 
 }  // namespace drape::sim::batches

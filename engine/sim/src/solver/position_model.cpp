@@ -559,12 +559,17 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Subste
   }
 }
 
-void dampConstraints(Cloth& cloth) {
+void dampConstraints(Cloth& cloth, const SolverScratch& scratch) {
   ParticleState& s = cloth.state;
   for (ConstraintKind kind : kConstraintKinds) {
     const Real damping = cloth.settings.material(kind).damping;
     if (damping == 0.0) continue;
-    for (const DistanceConstraint& c : cloth.rest.of(kind)) {
+    const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
+    const std::vector<std::uint32_t>& order = scratch.sweepOrder[static_cast<std::size_t>(kind)];
+    // In the seed's sweep's order (by particle pair) where it has one; with lines, as kept.
+    const bool byPair = order.size() == constraints.size() && !order.empty();
+    for (std::size_t i = 0; i < constraints.size(); ++i) {
+      const DistanceConstraint& c = constraints[byPair ? order[i] : i];
       const Real wa = s.inverseMass[c.a], wb = s.inverseMass[c.b];
       const Real wSum = wa + wb;
       if (wSum == 0.0) continue;

@@ -65,8 +65,9 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Subste
                         const std::vector<Collider>& colliders, Workers& workers, PartClock& parts);
 
 // Removes the kind's damping fraction of the relative velocity along each constraint, by moving
-// x_prev, conserving momentum.
-void dampConstraints(Cloth& cloth);
+// x_prev, conserving momentum. One after another, in the seed's sweep's order (scratch.sweepOrder,
+// by particle pair) where the plan has one, else (lines) in the order the cloth keeps them.
+void dampConstraints(Cloth& cloth, const SolverScratch& scratch);
 
 // Which way an XPBD link moves its two particles (projectCompliant: the sweep, the shear and bend
 // batches, the loose links; and the lines' solve): along its direction at the substep's start,

@@ -1574,8 +1574,13 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     }
     if (!strained.empty()) {
       build(cloth);
-      std::sort(strained.begin(), strained.end(), [](const auto& l, const auto& r) {
-        return l.first > r.first || (l.first == r.first && l.second < r.second);
+      // The most strained first; between links strained alike, by particle pair (not by where
+      // the cloth keeps them).
+      const auto pair = [&](std::uint32_t j) {
+        return std::pair{std::min(stretch[j].a, stretch[j].b), std::max(stretch[j].a, stretch[j].b)};
+      };
+      std::sort(strained.begin(), strained.end(), [&](const auto& l, const auto& r) {
+        return l.first > r.first || (l.first == r.first && pair(l.second) < pair(r.second));
       });
       Topology& topology = cloth.topology;
       std::vector<std::uint32_t> letGo;  // pieces a free link of has broken

@@ -42,7 +42,7 @@ struct Cloth {
   // negative when pulled) as the line solve last summed it, over a substep's first sweep, which
   // the next substep's geometric stiffness reads. It is state carried from step to step, like the
   // previous positions: a copy (undo, a snapshot) goes on bit for bit with it. Kept in the order of
-  // the stretch constraints (moved with them when the lines order them); empty where the solve
+  // the stretch constraints (moved with them where orderConstraints orders them); empty where the solve
   // keeps none, and emptied where the cloth is torn or cut. Single precision: it only scales the
   // geometric stiffness.
   std::vector<float> stretchTension;
@@ -293,10 +293,10 @@ class World {
  private:
   void buildPipeline();
   void buildTethers(std::size_t cloth);
-  // Batches and lines for the cloth's current constraints, once per topology (and after setThreads
-  // or tune): it reorders the cloth's constraints (bend and shear into batches, stretch into line
-  // order, lines::build), so their order in cloths() changes when the world is made and after a
-  // tear. A plan that is already up to date costs nothing.
+  // The cloth's solver plan, once per topology (and after setThreads or tune): with lines, the
+  // batches and lines read off the order the cloth keeps its constraints in (orderConstraints);
+  // with the seed's sweep, the order it takes them in (by particle pair). It reorders nothing. A
+  // plan that is already up to date costs nothing.
   void plan(std::size_t cloth);
   // Plans every cloth, where the pipeline projects constraints: at once, whenever what a plan is
   // made of changes (the world made, a cloth added, removed, restored, torn or cut, the threads
