@@ -58,12 +58,15 @@ void order(ClothRest& rest, std::array<std::vector<std::uint32_t>, kConstraintKi
     Colouring colouring = colourAll(paired, rest.particleCount());
     std::array<std::uint32_t, kColours + 1>& fill = colouring.count;
     for (std::uint32_t c = 0; c < kColours; ++c) fill[c + 1] += fill[c];
+    // Into a list of their own, exactly as long (a list grown by push_back has room to spare).
+    std::vector<DistanceConstraint> sorted(constraints.size());
     std::vector<std::uint32_t> from(constraints.size());  // where each ends up came from
     for (std::size_t k = 0; k < paired.size(); ++k) {
       const std::uint32_t to = fill[colouring.colourOf[k]]++;
-      constraints[to] = paired[k];
+      sorted[to] = paired[k];
       from[to] = byPair[k];
     }
+    constraints.swap(sorted);
     if (source && (*source)[kind].size() == from.size()) {
       std::vector<std::uint32_t> moved(from.size());
       for (std::size_t k = 0; k < from.size(); ++k) moved[k] = (*source)[kind][from[k]];
