@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -20,20 +19,17 @@ NaiveCloth::NaiveCloth(const sim::WorldSettings& world, int iterations)
     const sim::Vec3 x = rest.restPosition(i);
     particles_.push_back({x, x, 1.0 / particleMass});
   }
+  // The constraints in lattice order, as meshConstraints lists them (the engine keeps its lists in
+  // an order of its own, sim::orderConstraints).
+  std::vector<glm::ivec2> nodes;
+  for (int row = 0; row < rest.rows; ++row) {
+    for (int column = 0; column < rest.columns; ++column) nodes.push_back({column, row});
+  }
+  const auto lattice = sim::meshConstraints(rest, rest.triangles, nodes);
   for (sim::ConstraintKind kind : sim::kConstraintKinds) {
     const sim::Real stiffness = cloth.material(kind).stiffness;
     if (stiffness == 0.0) continue;
-    // In lattice order: by particle pair, each from its lower particle (the engine keeps its lists
-    // in an order of its own, sim::orderConstraints).
-    std::vector<sim::DistanceConstraint> lattice = rest.of(kind);
-    for (sim::DistanceConstraint& c : lattice) {
-      if (c.b < c.a) std::swap(c.a, c.b);
-    }
-    std::stable_sort(lattice.begin(), lattice.end(),
-                     [](const sim::DistanceConstraint& l, const sim::DistanceConstraint& r) {
-                       return std::pair{l.a, l.b} < std::pair{r.a, r.b};
-                     });
-    for (const sim::DistanceConstraint& c : lattice) {
+    for (const sim::DistanceConstraint& c : lattice[static_cast<std::size_t>(kind)]) {
       constraints_.push_back({static_cast<int>(c.a), static_cast<int>(c.b), c.restLength, stiffness});
     }
     if (kind == sim::ConstraintKind::stretch) structural_ = constraints_.size();

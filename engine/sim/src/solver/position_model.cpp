@@ -567,7 +567,7 @@ void dampConstraints(Cloth& cloth, const SolverScratch& scratch) {
     const std::vector<DistanceConstraint>& constraints = cloth.rest.of(kind);
     const std::vector<std::uint32_t>& order = scratch.sweepOrder[static_cast<std::size_t>(kind)];
     // In the seed's sweep's order (by particle pair) where it has one; with lines, as kept.
-    const bool byPair = order.size() == constraints.size() && !order.empty();
+    const bool byPair = order.size() == constraints.size();
     for (std::size_t i = 0; i < constraints.size(); ++i) {
       const DistanceConstraint& c = constraints[byPair ? order[i] : i];
       const Real wa = s.inverseMass[c.a], wb = s.inverseMass[c.b];
