@@ -296,6 +296,21 @@ std::vector<Real> particleAreas(const ClothRest& rest) {
   return area;
 }
 
+namespace {
+
+// The cotangent of the angle at corner o between the edges to p and q (at rest): infinite where
+// the triangle is degenerate.
+Real cotangentAt(const Vec3& o, const Vec3& p, const Vec3& q) {
+  const Vec3 a = p - o, b = q - o;
+  const Real sine = glm::length(glm::cross(a, b));
+  return sine > 0.0 ? glm::dot(a, b) / sine : std::numeric_limits<Real>::infinity();
+}
+
+// How thin a triangle may be for its cotangents to count: an angle of about a degree.
+constexpr Real kMostCotangent = 57.0;
+
+}  // namespace
+
 std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
   const std::size_t n = rest.particleCount();
   const std::vector<Real> area = particleAreas(rest);
@@ -315,6 +330,54 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
   }
   // By particle, not by the order the links are kept in.
   for (std::size_t i = 0; i < n; ++i) std::sort(other.begin() + start[i], other.begin() + start[i + 1]);
+  // Each particle's triangles, in the order the cloth lists them.
+  std::vector<std::uint32_t> triangleStart(n + 1, 0);
+  for (const glm::uvec3& t : rest.triangles) {
+    for (int k = 0; k < 3; ++k) ++triangleStart[t[k] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) triangleStart[i + 1] += triangleStart[i];
+  std::vector<std::uint32_t> around(triangleStart[n]);
+  std::vector<std::uint32_t> triangleFill(triangleStart.begin(), triangleStart.end() - 1);
+  for (std::uint32_t t = 0; t < rest.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) around[triangleFill[rest.triangles[t][k]]++] = t;
+  }
+  // Particle i's cotangent Laplacian, sqrt(A) / (2 A) sum_j w_j (x_j - x_i), into (neighbour,
+  // weight), by neighbour; false where i is on a border (an edge at it with one triangle, or more
+  // than two: its fan is not closed), has more neighbours than a stencil holds, or a triangle too
+  // thin. Weights that come to exactly 0 (a square cell's diagonal) are left out.
+  std::vector<std::pair<ParticleIndex, Real>> weights;
+  const auto cotangentStencil = [&](std::size_t i) {
+    weights.clear();
+    const Vec3 x = rest.restPosition(i);
+    for (std::uint32_t a = triangleStart[i]; a < triangleStart[i + 1]; ++a) {
+      const glm::uvec3& t = rest.triangles[around[a]];
+      const int c = t[0] == i ? 0 : t[1] == i ? 1 : 2;
+      const ParticleIndex p = t[(c + 1) % 3], q = t[(c + 2) % 3];
+      const Vec3 xp = rest.restPosition(p), xq = rest.restPosition(q);
+      // The edge i-p is opposite q's corner, the edge i-q opposite p's.
+      const Real atQ = cotangentAt(xq, x, xp), atP = cotangentAt(xp, x, xq);
+      if (!(std::abs(atQ) <= kMostCotangent) || !(std::abs(atP) <= kMostCotangent)) return false;
+      weights.push_back({p, atQ});
+      weights.push_back({q, atP});
+    }
+    if (weights.empty()) return false;
+    std::sort(weights.begin(), weights.end(), [](const auto& l, const auto& r) { return l.first < r.first; });
+    // Each neighbour twice (once from each triangle of their edge): a closed fan.
+    std::size_t out = 0;
+    for (std::size_t k = 0; k < weights.size();) {
+      std::size_t end = k;
+      Real w = 0.0;
+      while (end < weights.size() && weights[end].first == weights[k].first) w += weights[end++].second;
+      if (end - k != 2) return false;
+      if (w != 0.0) weights[out++] = {weights[k].first, w};
+      k = end;
+    }
+    weights.resize(out);
+    if (weights.empty() || weights.size() > kBendStencilSize - 1) return false;
+    const Real scale = 1.0 / (2.0 * std::sqrt(area[i]));
+    for (auto& [p, w] : weights) w *= scale;
+    return true;
+  };
   constexpr Real kOpposite = -0.99;  // cos 172 degrees
   std::vector<BendStencil> stencils;
   std::vector<bool> taken;  // of the particle's links, those on a line already
@@ -324,43 +387,52 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
     BendStencil stencil{};
     stencil.v.fill(static_cast<ParticleIndex>(i));
     stencil.k.fill(0.0f);
-    Real coefficient[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
-    int used = 1, lines = 0;
-    taken.assign(start[i + 1] - start[i], false);
-    for (std::uint32_t p = start[i]; p < start[i + 1] && lines < 2; ++p) {
-      if (taken[p - start[i]]) continue;
-      const Vec3 da = rest.restPosition(other[p]) - x;
-      const Real la = glm::length(da);
-      if (!(la > 0.0)) continue;
-      // The most nearly opposite link not yet taken.
-      std::optional<std::uint32_t> found;
-      Real bestCosine = kOpposite;
-      for (std::uint32_t q = p + 1; q < start[i + 1]; ++q) {
-        if (taken[q - start[i]]) continue;
-        const Vec3 db = rest.restPosition(other[q]) - x;
-        const Real lb = glm::length(db);
-        if (!(lb > 0.0)) continue;
-        const Real cosine = glm::dot(da, db) / (la * lb);
-        if (cosine < bestCosine) {
-          bestCosine = cosine;
-          found = q;
-        }
+    Real coefficient[kBendStencilSize] = {};
+    int used = 1;
+    if (cotangentStencil(i)) {
+      for (const auto& [p, w] : weights) {
+        stencil.v[used] = p;
+        coefficient[used++] = w;
       }
-      if (!found) continue;
-      const std::uint32_t best = *found;
-      taken[p - start[i]] = taken[best - start[i]] = true;
-      const Real lb = glm::length(rest.restPosition(other[best]) - x);
-      const Real scale = std::sqrt(area[i]) * 2.0 / (la + lb);
-      stencil.v[used] = other[p];
-      coefficient[used++] = scale / la;
-      stencil.v[used] = other[best];
-      coefficient[used++] = scale / lb;
-      ++lines;
+    } else {
+      // Its lines: at most two.
+      int lines = 0;
+      taken.assign(start[i + 1] - start[i], false);
+      for (std::uint32_t p = start[i]; p < start[i + 1] && lines < 2; ++p) {
+        if (taken[p - start[i]]) continue;
+        const Vec3 da = rest.restPosition(other[p]) - x;
+        const Real la = glm::length(da);
+        if (!(la > 0.0)) continue;
+        // The most nearly opposite link not yet taken.
+        std::optional<std::uint32_t> found;
+        Real bestCosine = kOpposite;
+        for (std::uint32_t q = p + 1; q < start[i + 1]; ++q) {
+          if (taken[q - start[i]]) continue;
+          const Vec3 db = rest.restPosition(other[q]) - x;
+          const Real lb = glm::length(db);
+          if (!(lb > 0.0)) continue;
+          const Real cosine = glm::dot(da, db) / (la * lb);
+          if (cosine < bestCosine) {
+            bestCosine = cosine;
+            found = q;
+          }
+        }
+        if (!found) continue;
+        const std::uint32_t best = *found;
+        taken[p - start[i]] = taken[best - start[i]] = true;
+        const Real lb = glm::length(rest.restPosition(other[best]) - x);
+        const Real scale = std::sqrt(area[i]) * 2.0 / (la + lb);
+        stencil.v[used] = other[p];
+        coefficient[used++] = scale / la;
+        stencil.v[used] = other[best];
+        coefficient[used++] = scale / lb;
+        ++lines;
+      }
     }
-    if (lines == 0) continue;
+    if (used == 1) continue;
     // Rounded to single precision, k[0] is what makes them sum to exactly 0.
     float sum = 0.0f;
-    for (int j = 1; j < 5; ++j) {
+    for (int j = 1; j < kBendStencilSize; ++j) {
       stencil.k[j] = static_cast<RestReal>(coefficient[j]);
       sum += stencil.k[j];
     }

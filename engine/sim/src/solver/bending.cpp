@@ -19,7 +19,9 @@ struct Touch {
 // the update are the constraint the projection measures, C = sum_{j>0} k_j (x_j - x_0).
 Real weightOf(const BendStencil& b, int j) {
   if (j > 0) return Real(b.k[j]);
-  return -(Real(b.k[1]) + Real(b.k[2]) + Real(b.k[3]) + Real(b.k[4]));
+  Real sum = 0.0;
+  for (int i = 1; i < kBendStencilSize; ++i) sum += Real(b.k[i]);
+  return -sum;
 }
 
 // Reverse Cuthill-McKee: the stencils renumbered so that those sharing a particle lie close in the
@@ -83,7 +85,7 @@ bool prepare(BendingFactor& factor, const std::vector<BendStencil>& stencils, co
   std::vector<std::uint32_t> start(particles + 1, 0);
   const auto each = [&](auto&& f) {
     for (std::uint32_t i = 0; i < n; ++i) {
-      for (int j = 0; j < 5; ++j) {
+      for (int j = 0; j < kBendStencilSize; ++j) {
         const ParticleIndex p = stencils[i].v[j];
         const Real k = weightOf(stencils[i], j);
         if (k != 0.0 && inverseMass[p] != 0.0) f(p, Touch{i, k});
@@ -175,7 +177,7 @@ void project(BendingFactor& factor, ParticleState& s, const std::vector<BendSten
     const BendStencil& b = stencils[i];
     Vec3 C{0.0};
     const Vec3 centre = x[b.v[0]];
-    for (int j = 1; j < 5; ++j) C += Real(b.k[j]) * (x[b.v[j]] - centre);
+    for (int j = 1; j < kBendStencilSize; ++j) C += Real(b.k[j]) * (x[b.v[j]] - centre);
     y[factor.rank[i]] = -(C + alphaTilde * lambda[i]);
   }
   // L y' = y, then L^T dlambda = y', in place.
@@ -196,7 +198,7 @@ void project(BendingFactor& factor, ParticleState& s, const std::vector<BendSten
     const BendStencil& b = stencils[i];
     const Vec3 delta = y[factor.rank[i]];
     lambda[i] += delta;
-    for (int j = 0; j < 5; ++j) x[b.v[j]] += (w[b.v[j]] * weightOf(b, j)) * delta;
+    for (int j = 0; j < kBendStencilSize; ++j) x[b.v[j]] += (w[b.v[j]] * weightOf(b, j)) * delta;
   }
 }
 

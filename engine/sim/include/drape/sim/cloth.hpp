@@ -55,19 +55,23 @@ struct LatticeSpec {
   LatticePlane plane = LatticePlane::xz;
 };
 
-// A fabric's bending at one particle (ClothSettings::fabric): the discrete Laplacian of the
-// positions along the stretch lines through it, C = sqrt(A) sum over lines of the curve's curvature
-// vector there, 2 / (la + lb) ((x_a - x) / la + (x_b - x) / lb) for the line's neighbours a and b at
-// rest distances la and lb, where A is the particle's share of the area (a third of its triangles').
-// C is linear in the positions and 0 while the sheet is flat; the stencil stores E = B / 2 |C|^2 (B
-// the bending rigidity, N m). Inside a sheet both lines count, so E is B / 2 (k1 + k2)^2 A: for a
-// sheet that does not stretch (k1 k2 = 0) the plate's energy, whichever way it bends (Bergou,
-// Wardetzky, Harmon, Zorin and Grinspun 2006, on the lattice's Laplacian). Along a border only the
-// border's line counts: a free edge carries no moment across itself. v[0] is the particle itself,
-// with k[0] = -(k[1] + ... + k[4]); an unused entry is v[0] again with k 0.
+// A fabric's bending at one particle (ClothSettings::fabric): C = sqrt(A) times the discrete
+// Laplacian of the positions there, where A is the particle's share of the area (a third of its
+// triangles'). C is linear in the positions and 0 while the sheet is flat; the stencil stores E = B /
+// 2 |C|^2 (B the bending rigidity, N m), so E is B / 2 (k1 + k2)^2 A: for a sheet that does not
+// stretch (k1 k2 = 0) the plate's energy, whichever way it bends (Bergou, Wardetzky, Harmon, Zorin
+// and Grinspun 2006; Wardetzky, Bergou, Harmon, Zorin and Grinspun 2007). Inside the cloth (its
+// triangles close all round the particle) the Laplacian is the cotangent one, 1 / (2 A) sum_j
+// (cot a_j + cot b_j) (x_j - x), which is exact for a linear field on any mesh, so a drawn cloth's
+// clipped cells bend as its lattice does; on a square lattice's cells it is the lattice's own
+// five-point Laplacian. Along a border only the border's line counts (its two links that point
+// opposite ways at rest, within 8 degrees), the curve's curvature vector 2 / (la + lb) ((x_a - x) /
+// la + (x_b - x) / lb): a free edge carries no moment across itself. v[0] is the particle itself,
+// with k[0] = -(k[1] + ... ); an unused entry is v[0] again with k 0.
+inline constexpr int kBendStencilSize = 9;  // the particle and up to 8 neighbours
 struct BendStencil {
-  std::array<ParticleIndex, 5> v;
-  std::array<RestReal, 5> k;  // 1/m; C = sum_{j>0} k_j (x_j - x_0)
+  std::array<ParticleIndex, kBendStencilSize> v;
+  std::array<RestReal, kBendStencilSize> k;  // 1/m; C = sum_{j>0} k_j (x_j - x_0)
   bool operator==(const BendStencil&) const = default;
 };
 
@@ -108,10 +112,11 @@ struct ConstraintSelection {
 Real triangleArea(const ClothRest& rest, const glm::uvec3& triangle);
 std::vector<Real> particleAreas(const ClothRest& rest);
 
-// Every particle's bend stencil, from the stretch constraints (their rest lengths) and the
-// triangles (the areas): a line through a particle is two of its stretch links that point opposite
-// ways at rest (within 8 degrees), at most two lines a particle. A particle on no line (a corner, a
-// tear's tip) gets none.
+// Every particle's bend stencil, from the triangles (the cotangent weights and the areas) inside
+// the cloth, and on its border from the stretch constraints: a line through a particle is two of
+// its stretch links that point opposite ways at rest (within 8 degrees). A border particle on no
+// line (a corner, a tear's tip) gets none; so does one inside with more than 8 neighbours or a
+// triangle too thin for its cotangents (under about a degree), which falls back to its lines.
 std::vector<BendStencil> buildBendStencils(const ClothRest& rest);
 
 // (column, row) of a particle that stands for no lattice node (LatticeMesh::nodes).
