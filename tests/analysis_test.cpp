@@ -271,10 +271,10 @@ TEST(Cantilever, ADrawnStripAlongTheLatticeIsWithinTwoPerCentOfTheElasticaAtEver
   }
 }
 
-TEST(Cantilever, ADrawnStripAtAnAngleToItsLatticeIsWithinFivePercentOnceItsStretchHasConverged) {
+TEST(Cantilever, ADrawnStripAtAnAngleToItsLatticeIsWithinThreePercentOnceItsStretchHasConverged) {
   // Denim drawn at 15, 30 and 45 degrees to the fill's lattice, 6.25 mm, with lines at 100 x 16
   // (its links within 0.3 %): the bend stencils of the clipped cells along its border, the
-  // cotangent Laplacian, bend it as the elastica does, within 2 % (docs/fabric.md, "Drawn
+  // cotangent Laplacian, bend it as the elastica does, within 2 % (3 % asked; docs/fabric.md, "Drawn
   // strips"). With a particle's two most nearly opposite pairs of links as its lines, as before, it
   // sat 7.4 and 6.5 % soft at 15 and 30 degrees and 5.2 % stiff at 45.
   CantileverSpec spec = drawnDenim(100);
@@ -285,7 +285,7 @@ TEST(Cantilever, ADrawnStripAtAnAngleToItsLatticeIsWithinFivePercentOnceItsStret
     ASSERT_FALSE(r.diverged);
     EXPECT_LT(r.tipMotion, 1e-5) << "still moving";
     EXPECT_LT(r.maxStrain, 0.005) << degrees;
-    EXPECT_NEAR(r.bendingLength / r.expected, 1.0, 0.05) << degrees;
+    EXPECT_NEAR(r.bendingLength / r.expected, 1.0, 0.03) << degrees;
     EXPECT_GT(r.chordAngle, 35.0 * kDegree);
   }
 }

@@ -194,7 +194,7 @@ int fabric(const FabricArguments& arguments) {
         << "  3.125 mm strip (4 to 12 % soft).\n"
         << "- **Converged runs are within a per cent.** The stencils are the lattice's Laplacian (the cotangent\n"
         << "  Laplacian, which on a lattice's cells is its five-point one), the same whichever way the sheet\n"
-        << "  is rolled (tests/sim/fabric_test.cpp,\n"
+        << "  is rolled (tests/sim/solver/fabric_test.cpp,\n"
         << "  `BendStencils.*`). An earlier model, a hinge per edge, bent 0.79 to 2.9 times as hard off the\n"
         << "  lattice's axes, and a strip twisted towards the soft way and sat 2 to 5 % soft.\n";
 

@@ -342,12 +342,17 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
     for (int k = 0; k < 3; ++k) around[triangleFill[rest.triangles[t][k]]++] = t;
   }
   // Particle i's cotangent Laplacian, sqrt(A) / (2 A) sum_j w_j (x_j - x_i), into (neighbour,
-  // weight), by neighbour; false where i is on a border (an edge at it with one triangle, or more
-  // than two: its fan is not closed), has more neighbours than a stencil holds, or a triangle too
-  // thin. Weights that come to exactly 0 (a square cell's diagonal) are left out.
+  // weight), by neighbour; false unless i's triangles go round it once, each turned the same way
+  // (each neighbour the first corner after i of one triangle and the second of another, and the
+  // walk from one to the next closing only after all of them): a particle on a border, where two
+  // fans meet, or under a doubled triangle has no one Laplacian. False too where a triangle is too
+  // thin for its cotangents, or the neighbours with a weight are more than a stencil holds. Weights
+  // that come to exactly 0 (a square cell's diagonal) are left out.
   std::vector<std::pair<ParticleIndex, Real>> weights;
+  std::vector<std::pair<ParticleIndex, ParticleIndex>> fan;  // each triangle's corners after i
   const auto cotangentStencil = [&](std::size_t i) {
     weights.clear();
+    fan.clear();
     const Vec3 x = rest.restPosition(i);
     for (std::uint32_t a = triangleStart[i]; a < triangleStart[i + 1]; ++a) {
       const glm::uvec3& t = rest.triangles[around[a]];
@@ -359,18 +364,30 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
       if (!(std::abs(atQ) <= kMostCotangent) || !(std::abs(atP) <= kMostCotangent)) return false;
       weights.push_back({p, atQ});
       weights.push_back({q, atP});
+      fan.push_back({p, q});
     }
-    if (weights.empty()) return false;
+    if (fan.empty()) return false;
+    // Once round: from the first triangle's p, each step to the q of the triangle whose p it is.
+    ParticleIndex at = fan[0].first;
+    for (std::size_t step = 0; step < fan.size(); ++step) {
+      std::size_t found = fan.size();
+      for (std::size_t k = 0; k < fan.size(); ++k) {
+        if (fan[k].first != at) continue;
+        if (found != fan.size()) return false;  // two triangles start at one neighbour
+        found = k;
+      }
+      if (found == fan.size()) return false;  // an open fan: a border
+      at = fan[found].second;
+      if (at == fan[0].first && step + 1 < fan.size()) return false;  // closed before all were met
+    }
+    if (at != fan[0].first) return false;
     std::sort(weights.begin(), weights.end(), [](const auto& l, const auto& r) { return l.first < r.first; });
-    // Each neighbour twice (once from each triangle of their edge): a closed fan.
+    // Each neighbour twice (once from each triangle of their edge), summed.
     std::size_t out = 0;
-    for (std::size_t k = 0; k < weights.size();) {
-      std::size_t end = k;
-      Real w = 0.0;
-      while (end < weights.size() && weights[end].first == weights[k].first) w += weights[end++].second;
-      if (end - k != 2) return false;
+    for (std::size_t k = 0; k < weights.size(); k += 2) {
+      if (weights[k + 1].first != weights[k].first) return false;
+      const Real w = weights[k].second + weights[k + 1].second;
       if (w != 0.0) weights[out++] = {weights[k].first, w};
-      k = end;
     }
     weights.resize(out);
     if (weights.empty() || weights.size() > kBendStencilSize - 1) return false;
@@ -429,13 +446,19 @@ std::vector<BendStencil> buildBendStencils(const ClothRest& rest) {
         ++lines;
       }
     }
-    if (used == 1) continue;
-    // Rounded to single precision, k[0] is what makes them sum to exactly 0.
+    // Rounded to single precision, the neighbours first (an entry whose weight rounds to 0 left
+    // out, so the used ones come first and a 0 ends them), and k[0] what makes them sum to exactly 0.
     float sum = 0.0f;
-    for (int j = 1; j < kBendStencilSize; ++j) {
-      stencil.k[j] = static_cast<RestReal>(coefficient[j]);
-      sum += stencil.k[j];
+    int kept = 1;
+    for (int j = 1; j < used; ++j) {
+      const auto k = static_cast<RestReal>(coefficient[j]);
+      if (k == 0.0f) continue;
+      stencil.v[kept] = stencil.v[j];
+      stencil.k[kept++] = k;
+      sum += k;
     }
+    for (int j = kept; j < kBendStencilSize; ++j) stencil.v[j] = static_cast<ParticleIndex>(i);
+    if (kept == 1) continue;
     stencil.k[0] = -sum;
     stencils.push_back(stencil);
   }

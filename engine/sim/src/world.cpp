@@ -1053,7 +1053,7 @@ void World::afterTopologyChange(std::size_t c, const std::vector<ParticleSplit>&
   grow(scratch.sumPosition, n);
   grow(scratch.sumVelocity, n);
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
-  // A fabric bends only along the stretch lines that still join it.
+  // A fabric's stencils from the triangles and links that still join it.
   if (cloth.settings.fabric) cloth.rest.bending = buildBendStencils(cloth.rest);
   // A tether may not reach across a tear; a torn-off copy of a particle is tied to its piece's pins
   // as the particle was. (Built afresh, as loading a snapshot builds them.)

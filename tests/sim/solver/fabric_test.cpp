@@ -46,14 +46,14 @@ std::vector<Vec3> rolled(const ClothRest& rest, double r, double degrees) {
   return x;
 }
 
-TEST(BendStencils, EveryParticleOnALineHasOneAndAFlatSheetStoresNoEnergy) {
+TEST(BendStencils, EveryParticleButTheCornersHasOneAndAFlatSheetStoresNoEnergy) {
   const ClothRest rest = flatSheet(9);
   // Every particle but the four corners (on no line: their two links are at right angles).
   ASSERT_EQ(rest.bending.size(), 81u - 4u);
-  int lines[3] = {0, 0, 0};
-  for (const BendStencil& b : rest.bending) ++lines[(b.k[3] != 0.0f ? 2 : 1)];
-  EXPECT_EQ(lines[2], 49);  // inside: both lines
-  EXPECT_EQ(lines[1], 28);  // the border: its own line only
+  int sizes[kBendStencilSize + 1] = {};
+  for (const BendStencil& b : rest.bending) ++sizes[stencilSize(b)];
+  EXPECT_EQ(sizes[5], 49);  // inside: the cotangent Laplacian, on square cells the five-point one
+  EXPECT_EQ(sizes[3], 28);  // the border: its own line only
   std::vector<Vec3> x;
   // Turned and moved far away, still flat: no energy (the coefficients sum to 0, exactly).
   const double c = std::cos(0.7), s = std::sin(0.7);
@@ -140,7 +140,7 @@ TEST(BendStencils, ADrawnSheetRolledAcrossItsSidesStoresThePlatesEnergyAtAnyAngl
           c += double(b.k[j]) * (x[b.v[j]] - x[b.v[0]]);
           used += b.k[j] != 0.0f;
         }
-        if (used <= 2) continue;  // a border's line
+        if (used <= 2) continue;  // a border's line (inside: the cotangent Laplacian, or two lines)
         insideEnergy += 0.5 * B * glm::dot(c, c);
         insideArea += areas[b.v[0]];
       }
@@ -151,6 +151,59 @@ TEST(BendStencils, ADrawnSheetRolledAcrossItsSidesStoresThePlatesEnergyAtAnyAngl
       EXPECT_GT(whole, 0.95) << degrees << " degrees, side " << side;
       EXPECT_LT(whole, 0.985) << degrees << " degrees, side " << side;
     }
+  }
+}
+
+// Particle 0 and six particles round it on a circle, spokes and rim as stretch links. `once`: six
+// triangles go once round it; `doubled`: and one of them listed twice; `pinched`: two fans of three
+// triangles each (the even corners' and the odd ones'), each closed, meeting only at particle 0.
+enum class Fan { once, doubled, pinched };
+ClothRest hexagon(Fan fan) {
+  ClothRest rest;
+  std::vector<Vec3> x{Vec3{0.0}};
+  for (int k = 0; k < 6; ++k)
+    x.push_back({0.1 * std::cos(k * std::numbers::pi / 3.0), 0.0, 0.1 * std::sin(k * std::numbers::pi / 3.0)});
+  rest.setRestPositions(x);
+  auto& stretch = rest.constraints[static_cast<std::size_t>(ConstraintKind::stretch)];
+  for (std::uint32_t k = 1; k <= 6; ++k) stretch.push_back({0u, k, 0.1f});
+  if (fan == Fan::pinched) {
+    for (std::uint32_t first : {1u, 2u}) {
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        const std::uint32_t a = first + 2 * k, b = first + 2 * ((k + 1) % 3);
+        rest.triangles.push_back({0u, b, a});
+        stretch.push_back({a, b, static_cast<float>(0.1 * std::sqrt(3.0))});
+      }
+    }
+  } else {
+    for (std::uint32_t k = 1; k <= 6; ++k) {
+      rest.triangles.push_back({0u, k % 6 + 1, k});
+      stretch.push_back({k, k % 6 + 1, 0.1f});
+    }
+    if (fan == Fan::doubled) rest.triangles.push_back(rest.triangles[2]);
+  }
+  rest.bending = buildBendStencils(rest);
+  return rest;
+}
+
+TEST(BendStencils, AParticleWhoseTrianglesGoOnceRoundItTakesTheCotangentLaplacianAndOtherwiseItsLines) {
+  for (const Fan fan : {Fan::once, Fan::doubled, Fan::pinched}) {
+    SCOPED_TRACE(static_cast<int>(fan));
+    const ClothRest rest = hexagon(fan);
+    ASSERT_FALSE(rest.bending.empty());
+    const BendStencil& centre = rest.bending[0];
+    ASSERT_EQ(centre.v[0], 0u);
+    // Once round: all six neighbours, each weighted (cot 60 + cot 60) / (2 sqrt(A)), A a third of
+    // the six triangles'. A triangle listed twice, or two fans that each close (every neighbour
+    // still on two triangles), have no one Laplacian: two of the three lines through it instead.
+    const double area = 6.0 * (std::sqrt(3.0) / 4.0 * 0.01) / 3.0;
+    EXPECT_EQ(stencilSize(centre), fan == Fan::once ? 7 : 5);
+    if (fan == Fan::once) {
+      for (int j = 1; j < 7; ++j) EXPECT_NEAR(centre.k[j], 2.0 / std::sqrt(3.0) / (2.0 * std::sqrt(area)), 1e-4);
+    }
+    // Flat, it stores nothing either way.
+    std::vector<Vec3> x;
+    for (std::size_t i = 0; i < rest.particleCount(); ++i) x.push_back(rest.restPosition(i));
+    EXPECT_LT(bendingEnergy(rest, x, 1.0), 1e-12);
   }
 }
 

@@ -20,7 +20,7 @@ struct Touch {
 Real weightOf(const BendStencil& b, int j) {
   if (j > 0) return Real(b.k[j]);
   Real sum = 0.0;
-  for (int i = 1; i < kBendStencilSize; ++i) sum += Real(b.k[i]);
+  for (int i = 1, used = stencilSize(b); i < used; ++i) sum += Real(b.k[i]);
   return -sum;
 }
 
@@ -177,7 +177,7 @@ void project(BendingFactor& factor, ParticleState& s, const std::vector<BendSten
     const BendStencil& b = stencils[i];
     Vec3 C{0.0};
     const Vec3 centre = x[b.v[0]];
-    for (int j = 1; j < kBendStencilSize; ++j) C += Real(b.k[j]) * (x[b.v[j]] - centre);
+    for (int j = 1, used = stencilSize(b); j < used; ++j) C += Real(b.k[j]) * (x[b.v[j]] - centre);
     y[factor.rank[i]] = -(C + alphaTilde * lambda[i]);
   }
   // L y' = y, then L^T dlambda = y', in place.
@@ -198,7 +198,7 @@ void project(BendingFactor& factor, ParticleState& s, const std::vector<BendSten
     const BendStencil& b = stencils[i];
     const Vec3 delta = y[factor.rank[i]];
     lambda[i] += delta;
-    for (int j = 0; j < kBendStencilSize; ++j) x[b.v[j]] += (w[b.v[j]] * weightOf(b, j)) * delta;
+    for (int j = 0, used = stencilSize(b); j < used; ++j) x[b.v[j]] += (w[b.v[j]] * weightOf(b, j)) * delta;
   }
 }
 

@@ -303,7 +303,8 @@ void projectBending(ParticleState& s, const std::vector<BendStencil>& stencils, 
     Real weight = 0.0;
     Vec3 C{0.0};
     const Vec3 centre = x[b.v[0]];
-    for (int j = 0; j < kBendStencilSize; ++j) {
+    const int used = stencilSize(b);
+    for (int j = 0; j < used; ++j) {
       const Real k = b.k[j];
       weight += w[b.v[j]] * k * k;
       if (j > 0) C += k * (x[b.v[j]] - centre);
@@ -311,7 +312,7 @@ void projectBending(ParticleState& s, const std::vector<BendStencil>& stencils, 
     if (weight == 0.0) continue;
     const Vec3 delta = (-C - alphaTilde * lambda[i]) / (weight + alphaTilde);
     lambda[i] += delta;
-    for (int j = 0; j < kBendStencilSize; ++j) x[b.v[j]] += (w[b.v[j]] * Real(b.k[j])) * delta;
+    for (int j = 0; j < used; ++j) x[b.v[j]] += (w[b.v[j]] * Real(b.k[j])) * delta;
   }
 }
 

@@ -67,13 +67,20 @@ struct LatticeSpec {
 // five-point Laplacian. Along a border only the border's line counts (its two links that point
 // opposite ways at rest, within 8 degrees), the curve's curvature vector 2 / (la + lb) ((x_a - x) /
 // la + (x_b - x) / lb): a free edge carries no moment across itself. v[0] is the particle itself,
-// with k[0] = -(k[1] + ... ); an unused entry is v[0] again with k 0.
+// with k[0] = -(k[1] + ... ); the neighbours follow, each k non-zero, and an unused entry after
+// them is v[0] again with k 0 (so the first k 0 ends a stencil).
 inline constexpr int kBendStencilSize = 9;  // the particle and up to 8 neighbours
 struct BendStencil {
   std::array<ParticleIndex, kBendStencilSize> v;
   std::array<RestReal, kBendStencilSize> k;  // 1/m; C = sum_{j>0} k_j (x_j - x_0)
   bool operator==(const BendStencil&) const = default;
 };
+// How many entries a stencil uses: the particle and its neighbours, up to the first k 0.
+inline int stencilSize(const BendStencil& b) {
+  int used = 1;
+  while (used < kBendStencilSize && b.k[used] != 0.0f) ++used;
+  return used;
+}
 
 struct ClothRest {
   int columns = 0;
@@ -112,11 +119,12 @@ struct ConstraintSelection {
 Real triangleArea(const ClothRest& rest, const glm::uvec3& triangle);
 std::vector<Real> particleAreas(const ClothRest& rest);
 
-// Every particle's bend stencil, from the triangles (the cotangent weights and the areas) inside
-// the cloth, and on its border from the stretch constraints: a line through a particle is two of
-// its stretch links that point opposite ways at rest (within 8 degrees). A border particle on no
-// line (a corner, a tear's tip) gets none; so does one inside with more than 8 neighbours or a
-// triangle too thin for its cotangents (under about a degree), which falls back to its lines.
+// Every particle's bend stencil, from the triangles (the cotangent weights and the areas) where
+// they go once round the particle, and elsewhere from the stretch constraints: a line through a
+// particle is two of its stretch links that point opposite ways at rest (within 8 degrees), at most
+// two lines. A particle inside whose cotangent stencil cannot be had (more than 8 neighbours with a
+// weight, or a triangle under about a degree) takes its lines instead. A particle on no line and
+// with no cotangent stencil (a border's corner, a tear's tip) gets none.
 std::vector<BendStencil> buildBendStencils(const ClothRest& rest);
 
 // (column, row) of a particle that stands for no lattice node (LatticeMesh::nodes).
