@@ -365,13 +365,56 @@ Walk walk(const ClothRest& rest) {
     std::vector<std::uint32_t> parent(n);
     std::iota(parent.begin(), parent.end(), 0u);
     std::vector<std::array<std::int64_t, 2>> next(n, {-1, -1});  // the constraints at each particle
+    const auto inFamily = [&](const DistanceConstraint& c) {
+      const Vec3 d = glm::abs(rest.restPosition(c.b) - rest.restPosition(c.a));
+      return (d.x >= std::max(d.y, d.z)) == (family == 0);
+    };
+    // Where a particle has more than two links of the family, the two most nearly opposite are the
+    // ones a line may take through it: on a drawn cloth's border at 45 degrees to the lattice, its
+    // two links along the border rather than the row's that ends there, so that the border is one
+    // line (taken as they came, every other border link was loose, and the loose pass after the
+    // lines undid them: docs/design.md, known limits).
+    std::vector<std::array<std::int64_t, 2>> preferred(n, {-1, -1});
+    {
+      // Each particle's links of the family (by particle pair), counted, then filled.
+      std::vector<std::uint32_t> start(n + 1, 0);
+      for (const std::uint32_t k : byPair) {
+        if (!inFamily(stretch[k])) continue;
+        ++start[stretch[k].a + 1];
+        ++start[stretch[k].b + 1];
+      }
+      for (std::size_t p = 0; p < n; ++p) start[p + 1] += start[p];
+      std::vector<std::uint32_t> at(start[n]), fill(start.begin(), start.end() - 1);
+      for (const std::uint32_t k : byPair) {
+        if (!inFamily(stretch[k])) continue;
+        at[fill[stretch[k].a]++] = k;
+        at[fill[stretch[k].b]++] = k;
+      }
+      for (std::size_t p = 0; p < n; ++p) {
+        if (start[p + 1] - start[p] <= 2) continue;
+        Real best = 2.0;  // ties: the pair met first, in particle-pair order
+        for (std::uint32_t i = start[p]; i < start[p + 1]; ++i) {
+          for (std::uint32_t j = i + 1; j < start[p + 1]; ++j) {
+            const DistanceConstraint &ci = stretch[at[i]], &cj = stretch[at[j]];
+            const Vec3 di = rest.restPosition(ci.a == p ? ci.b : ci.a) - rest.restPosition(p);
+            const Vec3 dj = rest.restPosition(cj.a == p ? cj.b : cj.a) - rest.restPosition(p);
+            const Real cosine = glm::dot(di, dj) / (glm::length(di) * glm::length(dj));
+            if (cosine < best) {
+              best = cosine;
+              preferred[p] = {at[i], at[j]};
+            }
+          }
+        }
+      }
+    }
+    const auto takes = [&](std::uint32_t p, std::uint32_t k) {
+      return preferred[p][0] < 0 || preferred[p][0] == k || preferred[p][1] == k;
+    };
     for (const std::uint32_t k : byPair) {
       const DistanceConstraint& c = stretch[k];
-      const Vec3 d = glm::abs(rest.restPosition(c.b) - rest.restPosition(c.a));
-      const bool alongX = d.x >= std::max(d.y, d.z);
-      if (alongX != (family == 0)) continue;
+      if (!inFamily(c)) continue;
       const std::uint32_t ra = findRoot(parent, c.a), rb = findRoot(parent, c.b);
-      if (degree[c.a] >= 2 || degree[c.b] >= 2 || ra == rb) {
+      if (degree[c.a] >= 2 || degree[c.b] >= 2 || ra == rb || !takes(c.a, k) || !takes(c.b, k)) {
         loose[static_cast<std::size_t>(family)].push_back(k);
         continue;
       }
