@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 #include <type_traits>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -34,23 +35,95 @@ struct Line {
   ParticleIndex operator[](std::size_t k) const { return k == 0 ? link[0].a : link[k - 1].b; }
 };
 
+// The spans of a line held at both ends: from a held particle over free ones to the next held one
+// (between two fingers, or a pin and a finger). With the seed's model (no compliance) a straight
+// span's system is singular (every link pulling alike moves nothing) and a nearly straight one's
+// nearly so. Pulled past its length, Thomas' algorithm puts the span's whole error in its last row,
+// whose pivot is (nearly) 0: either the links but the last are made exact and the last takes all
+// the others' stretch, or the tiny pivot's multiplier throws the span sideways (Newton's step for a
+// taut string's length: a kink of angle a changes the length by a per unit of sideways move, so the
+// step moves it error / a, far past where the length is met). A sheet pulled taut between a pinned
+// side and fingers never settled: its links ran between 0.13 and 2.8 times their rest length.
+//
+// settleHeldSpan takes the step, span by span, only as far as it mends the span: the largest of 1,
+// 1/2, 1/4, ... 1/64 of it after which the span's summed squared error is smaller than before, or
+// none. A healthy step leaves far less error than it found and stands bit for bit; a straight
+// span pulled past its length, which no move can shorten, keeps its stretch spread as the sweeps
+// left it. (XPBD's compliance makes the system regular, and a fabric pulled taut settles to its
+// even stretch without this: the line search there cut steps it needed. With geometric stiffness
+// the full step is the guard.)
+constexpr int kSpanHalvings = 6;
+
+void settleHeldSpan(const DistanceConstraint* link, std::size_t first, std::size_t last, const Vec3* x, const Real* w,
+                    const Vec3* normal, Real* solution, std::size_t stride, Real stiffness,
+                    std::vector<Vec3>& scratch) {
+  const std::size_t m = last - first + 1;
+  Real* solved = solution + first * stride;
+  const auto at = [&](std::size_t i) -> Real& { return solved[i * stride]; };
+  // The moves of the whole step: particle i is link i's a and link i - 1's b; the ends are held.
+  scratch.assign(m + 1, Vec3{0.0});
+  Vec3* move = scratch.data();
+  for (std::size_t i = 0; i < m; ++i) {
+    const DistanceConstraint& c = link[first + i];
+    const Vec3 push = normal[(first + i) * stride] * (stiffness * at(i));
+    move[i] -= w[c.a] * push;
+    move[i + 1] += w[c.b] * push;
+  }
+  const auto squaredError = [&](Real scale) {
+    Real sum = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const DistanceConstraint& c = link[first + i];
+      const Real e = glm::length(x[c.b] - x[c.a] + scale * (move[i + 1] - move[i])) - c.restLength;
+      sum += e * e;
+    }
+    return sum;
+  };
+  const Real before = squaredError(0.0);
+  Real scale = 1.0;
+  for (int k = 0; k <= kSpanHalvings && !(squaredError(scale) < before); ++k) scale *= 0.5;
+  if (scale == 1.0) return;
+  if (scale < std::ldexp(1.0, -kSpanHalvings)) scale = 0.0;
+  for (std::size_t i = 0; i < m; ++i) at(i) *= scale;
+}
+
+// Every held span of a line (settleHeldSpan), its links link[0, links), its solution strided.
+void settleHeldSpans(const DistanceConstraint* link, std::size_t links, const Vec3* x, const Real* w,
+                     const Vec3* normal, Real* solution, std::size_t stride, Real stiffness) {
+  thread_local std::vector<Vec3> scratch;
+  for (std::size_t k = 0; k < links;) {
+    if (w[link[k].a] != 0.0) {
+      ++k;
+      continue;
+    }
+    std::size_t last = k;
+    while (last < links && w[link[last].b] > 0.0) ++last;
+    if (last == links) return;  // it runs to the line's free end
+    if (last > k) settleHeldSpan(link, k, last, x, w, normal, solution, stride, stiffness, scratch);
+    k = last + 1;
+  }
+}
+
 // Solves G lines of n particles each in place, interleaved: line g has particles p[g][0..n) and
 // links p[g].link[0..n-2]. Each line's arithmetic is the same whatever G is; interleaving only lets the core
 // overlap the lines' chains of divisions (Thomas' recurrence is serial within a line).
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
 //
+// settleSpans: take the steps of spans held at both ends only as far as they mend them
+// (settleHeldSpans; the seed's model, without geometric stiffness).
 // With kAlongStart (XPBD) each link moves its particles along its direction at the substep's start
 // where it is slack enough (position::alongStart), which keeps the cloth's angular momentum:
 // dx_k = w_k (dlambda_{k-1} n0_{k-1} - dlambda_k n0_k), dlambda from the system above.
 template <std::size_t G, bool kAlongStart>
 void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array<Real*, G>& lambda,
                 const std::array<float*, G>& summed, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
-                Vec3* normal, Real* upper, Real* solution) {
+                bool settleSpans, Vec3* normal, Real* upper, Real* solution) {
   const std::size_t links = n - 1;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
   // Directions, diagonal (in upper) and right-hand side (in solution). A link whose particles
-  // coincide, or that nothing can move, gets the row of the identity and no correction.
+  // coincide, or that nothing can move, gets the row of the identity and no correction. And how
+  // many of each line's particles are held (settleHeldSpans: a line with two may have a span).
+  std::array<int, G> held{};
   for (std::size_t k = 0; k < links; ++k) {
     for (std::size_t g = 0; g < G; ++g) {
       const std::size_t at = k * G + g;
@@ -58,6 +131,7 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
       const Vec3 d = x[c.b] - x[c.a];
       const Real length2 = glm::dot(d, d);
       const Real diagonal = w[c.a] + w[c.b] + alphaTilde;
+      held[g] += (k == 0 && w[c.a] == 0.0) + (w[c.b] == 0.0);
       if (length2 > 1e-20 && diagonal > 0.0) {
         const Real length = std::sqrt(length2);
         normal[at] = d * (1.0 / length);
@@ -81,8 +155,8 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
       const Real lower = previousCoupling[g];
       const Real diagonal = upper[at];
       Real pivot = diagonal - lower * previousUpper[g];
-      // Only a particle caught between two immovable ones on a straight line makes the system
-      // singular; that link is then corrected as if alone.
+      // Only a span between two held particles, straight, makes the system singular, in its last
+      // row; that link is then corrected as if alone, and settleHeldSpans mends the span.
       if (!(pivot > 1e-9 * diagonal)) pivot = diagonal;
       const Real inverse = 1.0 / pivot;
       const Real coupling = k + 1 < links ? -w[p[g].link[k].b] * glm::dot(normal[at], normal[at + G]) : 0.0;
@@ -95,6 +169,9 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
   }
   for (std::size_t k = links - 1; k-- > 0;) {
     for (std::size_t g = 0; g < G; ++g) solution[k * G + g] -= upper[k * G + g] * solution[(k + 1) * G + g];
+  }
+  for (std::size_t g = 0; settleSpans && g < G; ++g) {
+    if (held[g] >= 2) settleHeldSpans(p[g].link, links, x, w, normal + g, solution + g, G, stiffness);
   }
   for (std::size_t k = 0; k < links; ++k) {
     for (std::size_t g = 0; g < G; ++g) {
@@ -634,23 +711,24 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
               }
             } else {
               // With geometric stiffness every solve adds its multipliers to the tension sums.
-              inGroups<4>(
-                  lines, stretch, line, last - first, xpbd,
-                  [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
-                                     const auto& firstLink, std::size_t n) {
-                    std::array<float*, G> summed{};
-                    for (std::size_t g = 0; geometricStiffness && scratch.sumTension && g < G; ++g) {
-                      summed[g] = cloth.stretchTension.data() + firstLink[g];
-                    }
-                    Vec3* normal = scratch.lineNormal.data() + slice;
-                    Real* upper = scratch.lineUpper.data() + slice;
-                    Real* solution = scratch.lineSolution.data() + slice;
-                    if (xpbd) {
-                      solveLines<G, true>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
-                    } else {
-                      solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
-                    }
-                  });
+              inGroups<4>(lines, stretch, line, last - first, xpbd,
+                          [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
+                                             const auto& firstLink, std::size_t n) {
+                            std::array<float*, G> summed{};
+                            for (std::size_t g = 0; geometricStiffness && scratch.sumTension && g < G; ++g) {
+                              summed[g] = cloth.stretchTension.data() + firstLink[g];
+                            }
+                            Vec3* normal = scratch.lineNormal.data() + slice;
+                            Real* upper = scratch.lineUpper.data() + slice;
+                            Real* solution = scratch.lineSolution.data() + slice;
+                            if (xpbd) {
+                              solveLines<G, true>(s, p, lambda, summed, restart, n, stiffness, alpha, false, normal,
+                                                  upper, solution);
+                            } else {
+                              solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha,
+                                                   !geometricStiffness, normal, upper, solution);
+                            }
+                          });
             }
           },
           grain);
