@@ -59,8 +59,8 @@ class App : public ::testing::Test {
     // so the app now and then found no display (3 of 89 starts under load, 0 of 113 with -noreset).
     const std::string command = "ASAN_OPTIONS=detect_leaks=0 DRAPE='" + std::string(DRAPE_APP) + "' DRAPE_ASSETS='" +
                                 std::string(DRAPE_ASSET_DIR) +
-                                "' timeout 180 xvfb-run -a -s '-screen 0 1024x768x24 -noreset' sh '" + body.string() + "' 2>'" +
-                                err.string() + "' >/dev/null";
+                                "' timeout 180 xvfb-run -a -s '-screen 0 1024x768x24 -noreset' sh '" + body.string() +
+                                "' 2>'" + err.string() + "' >/dev/null";
     const int status = std::system(command.c_str());
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read(err)};
   }

@@ -131,7 +131,7 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
       const Vec3 d = x[c.b] - x[c.a];
       const Real length2 = glm::dot(d, d);
       const Real diagonal = w[c.a] + w[c.b] + alphaTilde;
-      held[g] += (k == 0 && w[c.a] == 0.0) + (w[c.b] == 0.0);
+      if (settleSpans) held[g] += (k == 0 && w[c.a] == 0.0) + (w[c.b] == 0.0);
       if (length2 > 1e-20 && diagonal > 0.0) {
         const Real length = std::sqrt(length2);
         normal[at] = d * (1.0 / length);
@@ -156,7 +156,7 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
       const Real diagonal = upper[at];
       Real pivot = diagonal - lower * previousUpper[g];
       // Only a span between two held particles, straight, makes the system singular, in its last
-      // row; that link is then corrected as if alone, and settleHeldSpans mends the span.
+      // row; that link is then corrected as if alone (and with settleSpans the span is mended).
       if (!(pivot > 1e-9 * diagonal)) pivot = diagonal;
       const Real inverse = 1.0 / pivot;
       const Real coupling = k + 1 < links ? -w[p[g].link[k].b] * glm::dot(normal[at], normal[at + G]) : 0.0;
