@@ -221,6 +221,45 @@ TEST(Finger, CarriesAPinAndLeavesItWhereItWasPut) {
   EXPECT_NEAR(glm::length(world.cloths()[0].state.position[0] - Vec3{-0.5, 0.5, 0.0}), 0.0, 1e-12);
 }
 
+// A sheet hanging by a corner, tethered, its far corner taken by a finger and drawn 1 m past where
+// the cloth reaches: the grip slips, so the held particles stay within their tethers and the cloth
+// runs taut from the pin to the finger. Before, the finger held them there and the tethers kept the
+// particles beside them within reach: the links between took the whole pull, on hang2 one link 27
+// times its rest length. Both sweeps, the seed's and the fast one with a stretch target as hang2.
+TEST(Finger, CannotDrawATetheredClothPastItsReachFromAPin) {
+  for (const bool fast : {false, true}) {
+    SCOPED_TRACE(fast ? "lines, maxStretch 0.04" : "gauss-seidel");
+    WorldSettings settings = flatSheet(16, Vec3{0.0, -9.81, 0.0});
+    settings.solver.tethers = true;
+    if (fast) {
+      settings.solver.stretchSolver = StretchSolver::lines;
+      settings.solver.maxStretch = 0.04;
+      settings.solver.substeps = 1;
+      settings.solver.iterations = 1;
+    }
+    settings.cloths[0].pins = {{0, 0, std::nullopt}};
+    World world(settings);
+    world.run(60);
+    const Cloth& cloth = world.cloths()[0];
+    const ParticleIndex corner = cloth.rest.index(15, 15);
+    const Vec3 pin = cloth.state.position[0];
+    const Vec3 from = cloth.state.position[corner];
+    ASSERT_GT(world.pressFinger(1, from, 0.05), 0);
+    // 1 m further from the pin than it is (it hangs within its reach of sqrt(2) m), over a second.
+    const Vec3 away = glm::normalize(from - pin);
+    for (int step = 1; step <= 60; ++step) {
+      world.moveFinger(1, from + away * (step / 60.0));
+      ASSERT_EQ(world.step(), StepStatus::ok);
+    }
+    world.run(30);
+    for (const ParticleIndex p : held(world, 1)) {
+      const Real reach = glm::length(cloth.rest.restPosition(p) - cloth.rest.restPosition(0));
+      EXPECT_LE(glm::length(cloth.state.position[p] - pin), reach * (1.0 + 1e-6));
+    }
+    EXPECT_LT(worstTriangleStretch(cloth), 1.1);
+  }
+}
+
 // A sheet pinned along x = 0, pulled by a finger along its far edge until it tears.
 World pulledApart(Real threshold, int steps) {
   WorldSettings settings = flatSheet(11);

@@ -977,7 +977,18 @@ void World::moveFingers(Real h) {
     const Vec3 start = f.position + path * from;
     const Vec3 travel = path * (to - from);
     for (const FingerGrip& grip : f.grips) {
-      ParticleState& s = records_[static_cast<std::size_t>(grip.cloth)].cloth.state;
+      ClothRecord& record = records_[static_cast<std::size_t>(grip.cloth)];
+      ParticleState& s = record.cloth.state;
+      // Where the cloth cannot tear, a finger cannot hold a particle beyond its tethers (as far from
+      // each pin as at rest): the cloth is taut from the pin to the finger there, and the grip slips
+      // along it. (Held there, the tethers kept the particles beside it within reach, and the links
+      // between took the whole pull: on hang2, a corner drawn 30 cm down past the sheet's reach left
+      // one link 27 times its rest length; docs/design.md.) A cloth that can tear is torn instead.
+      const SolverScratch::Tethers& tethers = record.work->solver.tethers;
+      const bool slips = !tethers.empty() && !settings_.tearing.enabled;
+      const auto reach = [&](const Vec3& at) {
+        return slips ? position::withinTethers(s, tethers, grip.particle, at) : at;
+      };
       if (selfContactHolds_) {
         // Self-contact may have held the particle back where the finger would have driven it through
         // cloth (its fail-safe moves a held particle with the rest of an impact zone): it goes on from
@@ -986,7 +997,7 @@ void World::moveFingers(Real h) {
         // It catches up at most half the contact distance a substep faster than the finger moves, so
         // that it is not flung when it comes free (nor when the finger lets go just then).
         const Vec3 x = s.position[grip.particle];
-        Vec3 move = start + travel + grip.offset - x;
+        Vec3 move = reach(start + travel + grip.offset) - x;
         const Real length = glm::length(move), most = glm::length(travel) + 0.5 * settings_.selfCollision.distance;
         if (length > most) move *= most / length;
         s.previousPosition[grip.particle] = x - move;
@@ -994,9 +1005,10 @@ void World::moveFingers(Real h) {
       }
       // Set where the finger is at the start of the substep, and one substep's travel behind: the
       // integrator then carries the particle to where the finger is at its end (inverse mass 0).
-      s.position[grip.particle] = start + grip.offset;
-      s.previousPosition[grip.particle] = start + grip.offset - travel;
-      if (!s.velocity.empty()) s.velocity[grip.particle] = travel / h;
+      const Vec3 at = reach(start + grip.offset), by = reach(start + travel + grip.offset) - at;
+      s.position[grip.particle] = at;
+      s.previousPosition[grip.particle] = at - by;
+      if (!s.velocity.empty()) s.velocity[grip.particle] = by / h;
     }
   }
 }

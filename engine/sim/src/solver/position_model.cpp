@@ -384,6 +384,29 @@ void holdLayers(Cloth& cloth, const SolverScratch& scratch) {
 
 }  // namespace
 
+Vec3 withinTethers(const ParticleState& s, const SolverScratch::Tethers& tethers, ParticleIndex particle, Vec3 point) {
+  const std::vector<SolverScratch::Tethers::Run>& runs = tethers.run;
+  const auto after = std::upper_bound(runs.begin(), runs.end(), particle,
+                                      [](ParticleIndex i, const auto& run) { return i < run.first; });
+  if (after == runs.begin()) return point;
+  const SolverScratch::Tethers::Run& run = *(after - 1);
+  if (particle >= run.first + run.count) return point;  // pinned: no tethers of its own
+  const std::size_t i = particle - run.first;
+  const ParticleIndex* pin = tethers.pin.data() + run.pins;
+  const Real* w = s.inverseMass.data();
+  const Vec3* x = s.position.data();
+  const RestReal* length = tethers.length.data() + run.lengths + i * run.pinCount;
+  if (run.pinCount == 2 && w[pin[0]] == 0.0 && w[pin[1]] == 0.0) {
+    PinAxis axis;
+    axis.update(pin[0], pin[1], x[pin[0]], x[pin[1]]);
+    return intoLens(point, x[pin[0]], length[0], x[pin[1]], length[1], axis);
+  }
+  for (std::uint32_t j = 0; j < run.pinCount; ++j) {
+    if (w[pin[j]] == 0.0) point = intoBall(point, x[pin[j]], length[j]);
+  }
+  return point;
+}
+
 namespace {
 
 Stage partOf(ConstraintKind kind) {

@@ -105,6 +105,10 @@ inline Vec3 alongStart(const Vec3& n, const Vec3& a0, const Vec3& b0, Real lambd
 void projectCompliant(std::vector<Vec3>& position, const std::vector<Vec3>& start, const std::vector<Real>& inverseMass,
                       const DistanceConstraint& constraint, Real alphaTilde, Real& lambda);
 
+// The nearest point to `point` within the particle's tethers (its pins' balls, those still pinned),
+// as projectTethers would put the particle there; `point` itself for a particle with none.
+Vec3 withinTethers(const ParticleState& s, const SolverScratch::Tethers& tethers, ParticleIndex particle, Vec3 point);
+
 // One constraint, exposed for tests.
 void projectDistance(std::vector<Vec3>& position, const std::vector<Real>& inverseMass,
                      const DistanceConstraint& constraint, Real stiffness);
