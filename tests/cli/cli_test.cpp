@@ -578,7 +578,7 @@ TEST_F(Cli, BenchPlaysEachWholeTouchCaseAgainWithGravityMovedInItsSeventhDigit) 
   std::string line;
   std::getline(csv, line);
   EXPECT_EQ(line, "case,n,run,gravity_scale,free_strain_end,free_strain_worst,pairs_worst");
-  std::map<std::string, std::vector<double>> worst;
+  std::map<std::string, std::vector<double>> worst, ends;
   while (std::getline(csv, line)) {
     char name[32], scale[16];
     int n = 0, k = -1;
@@ -592,15 +592,18 @@ TEST_F(Cli, BenchPlaysEachWholeTouchCaseAgainWithGravityMovedInItsSeventhDigit) 
     EXPECT_EQ(std::string(scale), k == 0 ? "1" : "1+" + std::to_string(k) + "e-7") << line;
     EXPECT_EQ(pairs, 0u) << line;
     worst[name].push_back(most);
+    ends[name].push_back(end);
   }
   ASSERT_EQ(worst.size(), 2u);
   for (const auto& [name, runs] : worst) {
     ASSERT_EQ(runs.size(), 3u) << name;
     EXPECT_EQ(runs[0], timed[name]) << name;  // the timed run is the first
   }
-  // The crumple is chaotic: moved in the seventh digit, its worst link comes out otherwise.
-  EXPECT_NE(worst["desk crumple"][1], worst["desk crumple"][0]);
-  EXPECT_NE(worst["desk crumple"][2], worst["desk crumple"][1]);
+  // The crumple is chaotic: moved in the seventh digit, it ends otherwise. (Its worst link over the
+  // run comes as the fingers first draw the cloth, before the perturbation has grown: 0.5489 in
+  // each run to eight digits since the steps of spans held between fingers are damped, lines.cpp.)
+  EXPECT_NE(ends["desk crumple"][1], ends["desk crumple"][0]);
+  EXPECT_NE(ends["desk crumple"][2], ends["desk crumple"][1]);
   const std::string text = read(report);
   EXPECT_NE(text.find("How the outcome spreads over chance"), std::string::npos);
   EXPECT_NE(text.find("| desk crumple | 8 | 3 |"), std::string::npos);
