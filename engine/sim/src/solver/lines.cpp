@@ -128,6 +128,9 @@ void settleHeldSpan(const DistanceConstraint* link, std::size_t first, std::size
       previousStep = dl[i];
     }
     for (std::size_t i = m - 1; i-- > 0;) dl[i] -= upper[i] * dl[i + 1];
+    // Taken as the full step is: `stiffness` of it (the seed's share of the violation a sweep
+    // corrects; 1 with XPBD).
+    for (std::size_t i = 0; i < m; ++i) dl[i] *= stiffness;
     if (measure(dl) < before) {
       for (std::size_t i = 0; i < m; ++i) solution[(first + i) * stride] = dl[i] / stiffness;
       return;
