@@ -238,6 +238,31 @@ Vec3 intoLens(Vec3 x, Vec3 a, Real ra, Vec3 b, Real rb, const PinAxis& axis) {
   return centre + off * (rho / offLength);
 }
 
+// Whether every pin of a run of tethered particles still holds (is pinned, not let go).
+bool allPinned(const SolverScratch::Tethers& tethers, const SolverScratch::Tethers::Run& run, const Real* w) {
+  const ParticleIndex* pin = tethers.pin.data() + run.pins;
+  bool all = true;
+  for (std::uint32_t j = 0; j < run.pinCount; ++j) all = all && w[pin[j]] == 0.0;
+  return all;
+}
+
+// `point` within the tethers of the run's particle i: the lens of its two pins where both hold
+// (allPinned), else the ball of each pin that holds, in turn. `axis` keeps the line between the
+// two pins for the next particle of the run.
+Vec3 intoTethers(Vec3 point, const SolverScratch::Tethers& tethers, const SolverScratch::Tethers::Run& run,
+                 std::size_t i, const Vec3* x, const Real* w, bool allPinned, PinAxis& axis) {
+  const ParticleIndex* pin = tethers.pin.data() + run.pins;
+  const RestReal* length = tethers.length.data() + run.lengths + i * run.pinCount;
+  if (run.pinCount == 2 && allPinned) {
+    axis.update(pin[0], pin[1], x[pin[0]], x[pin[1]]);
+    return intoLens(point, x[pin[0]], length[0], x[pin[1]], length[1], axis);
+  }
+  for (std::uint32_t j = 0; j < run.pinCount; ++j) {
+    if (w[pin[j]] == 0.0) point = intoBall(point, x[pin[j]], length[j]);
+  }
+  return point;
+}
+
 // The tethered particles [begin, end) (counted over the runs, in order). A tether holds while its
 // pin is pinned (not let go) and nothing holds its particle (a finger then decides where it is).
 // A particle is never a pin while it is projected (its inverse mass is not 0), so each one reads
@@ -252,29 +277,13 @@ void projectTethers(ParticleState& s, const SolverScratch::Tethers& tethers, std
   PinAxis axis;  // pins do not move while tethers are projected
   for (; r < runs.size() && runs[r].before < end; ++r) {
     const SolverScratch::Tethers::Run& run = runs[r];
-    const ParticleIndex* pin = tethers.pin.data() + run.pins;
     const std::size_t from = std::max(begin, std::size_t{run.before}) - run.before;
     const std::size_t to = std::min(end, std::size_t{run.before} + run.count) - run.before;
-    bool allPinned = true;
-    for (std::uint32_t j = 0; j < run.pinCount; ++j) allPinned = allPinned && w[pin[j]] == 0.0;
-    if (run.pinCount == 2 && allPinned) {
-      const Vec3 a = x[pin[0]], b = x[pin[1]];
-      axis.update(pin[0], pin[1], a, b);
-      for (std::size_t i = from; i < to; ++i) {
-        const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
-        if (w[particle] == 0.0) continue;
-        const RestReal* length = tethers.length.data() + run.lengths + 2 * i;
-        x[particle] = intoLens(x[particle], a, length[0], b, length[1], axis);
-      }
-      continue;
-    }
+    const bool pinned = allPinned(tethers, run, w);
     for (std::size_t i = from; i < to; ++i) {
       const ParticleIndex particle = run.first + static_cast<ParticleIndex>(i);
       if (w[particle] == 0.0) continue;
-      const RestReal* length = tethers.length.data() + run.lengths + i * run.pinCount;
-      for (std::uint32_t j = 0; j < run.pinCount; ++j) {
-        if (w[pin[j]] == 0.0) x[particle] = intoBall(x[particle], x[pin[j]], length[j]);
-      }
+      x[particle] = intoTethers(x[particle], tethers, run, i, x, w, pinned, axis);
     }
   }
 }
@@ -391,20 +400,9 @@ Vec3 withinTethers(const ParticleState& s, const SolverScratch::Tethers& tethers
   if (after == runs.begin()) return point;
   const SolverScratch::Tethers::Run& run = *(after - 1);
   if (particle >= run.first + run.count) return point;  // pinned: no tethers of its own
-  const std::size_t i = particle - run.first;
-  const ParticleIndex* pin = tethers.pin.data() + run.pins;
   const Real* w = s.inverseMass.data();
-  const Vec3* x = s.position.data();
-  const RestReal* length = tethers.length.data() + run.lengths + i * run.pinCount;
-  if (run.pinCount == 2 && w[pin[0]] == 0.0 && w[pin[1]] == 0.0) {
-    PinAxis axis;
-    axis.update(pin[0], pin[1], x[pin[0]], x[pin[1]]);
-    return intoLens(point, x[pin[0]], length[0], x[pin[1]], length[1], axis);
-  }
-  for (std::uint32_t j = 0; j < run.pinCount; ++j) {
-    if (w[pin[j]] == 0.0) point = intoBall(point, x[pin[j]], length[j]);
-  }
-  return point;
+  PinAxis axis;
+  return intoTethers(point, tethers, run, particle - run.first, s.position.data(), w, allPinned(tethers, run, w), axis);
 }
 
 namespace {
