@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <type_traits>
 #include <vector>
@@ -63,6 +64,14 @@ struct Line {
 // stiff fabric's only just (alpha~ about 6e-4 of the diagonal for cotton at 32 x 32): pulled at
 // 1 m/s, its rows were thrown from 0.16 to 3.5 times their length within 0.15 s (now 1.148 to
 // 1.152, the pull's 15 %). (With geometric stiffness the full step is the guard.)
+//
+// Pushed shorter than its links instead (fingers closing on a cloth), a straight span is as
+// singular: the full step made every link but one exact and turned that one round (its particle
+// carried through its neighbour, the link its length again, so the summed error read 0), and the
+// cloth beside it took the shortfall: the shipped desk's crumple, a step after its six fingers
+// touched down and before they had moved 2 mm, had links 44 % long between them. A step that turns
+// a link of the span round is now refused, and a span short on the whole also tries the even step
+// (below), which spreads the shortfall over its links.
 constexpr Real kFirstDamping = 1e-3, kLastDamping = 1e2;
 
 struct SpanScratch {
@@ -98,41 +107,77 @@ void settleHeldSpan(const DistanceConstraint* link, std::size_t first, std::size
     }
     for (std::size_t i = 0; i < m; ++i) {
       const DistanceConstraint& c = link[first + i];
-      const Real e = glm::length(x[c.b] - x[c.a] + move[i + 1] - move[i]) - c.restLength + alphaTilde * lambdaOf(i);
+      const Vec3 d = x[c.b] - x[c.a] + move[i + 1] - move[i];
+      // A link the step turns round (its particle carried through its neighbour) may come out its
+      // length, but the cloth is folded through itself there: no such step is taken.
+      if (!(glm::dot(d, normalOf(i)) > 0.0)) return std::numeric_limits<Real>::infinity();
+      const Real e = glm::length(d) - c.restLength + alphaTilde * lambdaOf(i);
       sum += compliant ? e * e / (2.0 * alphaTilde) : e * e;
     }
     return sum;
   };
-  scratch.step.assign(2 * m, 0.0);
+  scratch.step.assign(3 * m, 0.0);
   Real* dl = scratch.step.data();
   Real* upper = dl + m;
+  Real* even = dl + 2 * m;
   const Real before = measure(dl);  // (no step)
+  // Each link's error (XPBD: with its compliance's share), and the span's mean.
+  Real mean = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const DistanceConstraint& c = link[first + i];
+    mean += glm::length(x[c.b] - x[c.a]) - c.restLength + alphaTilde * lambdaOf(i);
+  }
+  mean /= static_cast<Real>(m);
+  // Thomas' algorithm on the span's rows with mu on the diagonal, as solveLines' (its ends held:
+  // nothing couples beyond), for each link's error less `shift`, into out; a pivot the system
+  // leaves (nearly) 0 is its diagonal, as in solveLines. Taken as the full step is: `stiffness` of
+  // it (the seed's share of the violation a sweep corrects; 1 with XPBD).
+  const auto solveSpan = [&](Real mu, Real shift, Real* out) {
+    Real previousUpper = 0.0, previousStep = 0.0, previousCoupling = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      const DistanceConstraint& c = link[first + i];
+      const Real diagonal = w[c.a] + w[c.b] + alphaTilde + mu;
+      Real pivot = diagonal - previousCoupling * previousUpper;
+      if (!(pivot > 1e-9 * diagonal)) pivot = diagonal;
+      const Real coupling = i + 1 < m ? -w[c.b] * glm::dot(normalOf(i), normalOf(i + 1)) : 0.0;
+      const Real rightHand = -(glm::length(x[c.b] - x[c.a]) - c.restLength) - alphaTilde * lambdaOf(i) + shift;
+      upper[i] = coupling / pivot;
+      out[i] = (rightHand - previousCoupling * previousStep) / pivot;
+      previousCoupling = coupling;
+      previousUpper = upper[i];
+      previousStep = out[i];
+    }
+    for (std::size_t i = m - 1; i-- > 0;) out[i] -= upper[i] * out[i + 1];
+    for (std::size_t i = 0; i < m; ++i) out[i] *= stiffness;
+  };
+  const auto keep = [&](const Real* step) {
+    for (std::size_t i = 0; i < m; ++i) solution[(first + i) * stride] = step[i] / stiffness;
+  };
   for (std::size_t i = 0; i < m; ++i) dl[i] = solution[(first + i) * stride] * stiffness;
-  if (measure(dl) < before) return;
+  const Real full = measure(dl);
+  // A span pushed shorter than its links (fingers closing on it): where it lies straight, no move
+  // along it shortens it, and the full step makes every link but one exact and folds that one
+  // back through its neighbour (which the measure refuses), or piles the shortfall on a few. The
+  // even step spreads it over every link alike (each link's error less the span's mean: a system
+  // the straight span can solve), the least summed error of any move along a straight span. Where
+  // the span is bent and can take its links' lengths back by a move (it buckles), the full step
+  // does better and is kept.
+  if (mean < 0.0) {
+    solveSpan(0.0, mean, even);
+    const Real evenly = measure(even);
+    if (evenly < before && !(full <= evenly)) {
+      keep(even);
+      return;
+    }
+  }
+  if (full < before) return;
   Real meanDiagonal = 0.0;
   for (std::size_t i = 0; i < m; ++i) meanDiagonal += w[link[first + i].a] + w[link[first + i].b];
   meanDiagonal /= static_cast<Real>(m);
   for (Real damping = kFirstDamping; damping <= kLastDamping; damping *= 10.0) {
-    // Thomas' algorithm on the span's rows, as solveLines' (its ends held: nothing couples beyond).
-    const Real mu = damping * meanDiagonal;
-    Real previousUpper = 0.0, previousStep = 0.0, previousCoupling = 0.0;
-    for (std::size_t i = 0; i < m; ++i) {
-      const DistanceConstraint& c = link[first + i];
-      const Real pivot = w[c.a] + w[c.b] + alphaTilde + mu - previousCoupling * previousUpper;
-      const Real coupling = i + 1 < m ? -w[c.b] * glm::dot(normalOf(i), normalOf(i + 1)) : 0.0;
-      const Real rightHand = -(glm::length(x[c.b] - x[c.a]) - c.restLength) - alphaTilde * lambdaOf(i);
-      upper[i] = coupling / pivot;
-      dl[i] = (rightHand - previousCoupling * previousStep) / pivot;
-      previousCoupling = coupling;
-      previousUpper = upper[i];
-      previousStep = dl[i];
-    }
-    for (std::size_t i = m - 1; i-- > 0;) dl[i] -= upper[i] * dl[i + 1];
-    // Taken as the full step is: `stiffness` of it (the seed's share of the violation a sweep
-    // corrects; 1 with XPBD).
-    for (std::size_t i = 0; i < m; ++i) dl[i] *= stiffness;
+    solveSpan(damping * meanDiagonal, 0.0, dl);
     if (measure(dl) < before) {
-      for (std::size_t i = 0; i < m; ++i) solution[(first + i) * stride] = dl[i] / stiffness;
+      keep(dl);
       return;
     }
   }
