@@ -260,6 +260,45 @@ TEST(Finger, CannotDrawATetheredClothPastItsReachFromAPin) {
   }
 }
 
+TEST(Finger, TwoFingersTurnWhatTheyHoldWithThem) {
+  // A 16 x 16 sheet without gravity, a finger on either side of its middle (10 cm patches), turned a
+  // quarter turn about the sheet's middle over a second. The fingers turn what they hold with them,
+  // so the sheet turns whole: every held particle stays where its offset, turned, puts it, and no
+  // triangle's edge stretches more than 2 % (1.1 % as the free corners are swung round). Held
+  // without turning, each patch kept its heading, the links around the patches took the turn
+  // (edges 3.35 times their length) and the far corner ended 8 cm from where the turn puts it.
+  WorldSettings settings = flatSheet(16);
+  World world(settings);
+  const Cloth& cloth = world.cloths()[0];
+  const Vec3 middle{0.5, 0.0, 0.5};
+  ASSERT_GT(world.pressFinger(1, middle + Vec3{0.3, 0.0, 0.0}, 0.1), 0);
+  ASSERT_GT(world.pressFinger(2, middle - Vec3{0.3, 0.0, 0.0}, 0.1), 0);
+  std::vector<Vec3> start;
+  for (const ParticleIndex p : held(world, 1)) start.push_back(cloth.state.position[p] - middle);
+  const Real quarter = 3.14159265358979 / 2.0;
+  Real worst = 0.0;
+  for (int step = 1; step <= 60; ++step) {
+    const Real a = quarter * step / 60.0;
+    // Turned by a about +y (gravity is zero: the up axis is +y).
+    const auto turn = [&](Vec3 v) {
+      return Vec3{v.x * std::cos(a) + v.z * std::sin(a), v.y, -v.x * std::sin(a) + v.z * std::cos(a)};
+    };
+    world.moveFinger(1, middle + turn(Vec3{0.3, 0.0, 0.0}));
+    world.moveFinger(2, middle + turn(Vec3{-0.3, 0.0, 0.0}));
+    ASSERT_EQ(world.step(), StepStatus::ok);
+    worst = std::max(worst, worstTriangleStretch(cloth));
+    if (step == 60) {
+      const std::vector<ParticleIndex> grips = held(world, 1);
+      for (std::size_t k = 0; k < grips.size(); ++k) {
+        EXPECT_LT(glm::length(cloth.state.position[grips[k]] - (middle + turn(start[k]))), 1e-9);
+      }
+    }
+  }
+  EXPECT_LT(worst, 1.02);
+  // The far corners turned with it: (1, 0, 1) about the middle is now at (1, 0, 0).
+  EXPECT_LT(glm::length(cloth.state.position[cloth.rest.index(15, 15)] - Vec3{1.0, 0.0, 0.0}), 0.01);
+}
+
 // A sheet pinned along x = 0, pulled by a finger along its far edge until it tears.
 World pulledApart(Real threshold, int steps) {
   WorldSettings settings = flatSheet(11);

@@ -32,6 +32,13 @@ namespace drape::sim {
 
 namespace {
 
+// v turned by `angle` (radians) about the unit axis u.
+Vec3 turned(const Vec3& v, const Vec3& u, Real angle) {
+  if (angle == 0.0) return v;
+  const Real c = std::cos(angle), s = std::sin(angle);
+  return v * c + glm::cross(u, v) * s + u * (glm::dot(u, v) * (1.0 - c));
+}
+
 constexpr Real kLargest = std::numeric_limits<Real>::max();
 bool finite(Real value) { return std::isfinite(value); }
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -781,6 +788,14 @@ StepStatus World::step() {
     for (Collider& collider : colliders_) collider.setTime(time());  // back where the last good positions saw them
     return StepStatus::diverged;
   }
+  // The grips keep the turn the step gave them (moveFingers).
+  const Real twist = fingersTwist();
+  if (twist != 0.0) {
+    const Vec3 axis = fingersAxis();
+    for (Finger& finger : fingers_) {
+      for (FingerGrip& grip : finger.grips) grip.offset = turned(grip.offset, axis, twist);
+    }
+  }
   for (Finger& finger : fingers_) finger.position = finger.target;
   ++stepCount_;
   if constexpr (kCheckInvariants) checkInvariants();
@@ -969,14 +984,60 @@ int World::unpin(Vec3 point, Real radius) {
   return freed;
 }
 
+// The up axis a hand turns about: against gravity, or +y without it.
+Vec3 World::fingersAxis() const {
+  const Real g = glm::length(settings_.gravity);
+  return g > 0.0 && std::isfinite(g) ? -settings_.gravity / g : Vec3{0.0, 1.0, 0.0};
+}
+
+Real World::fingersTwist() const {
+  // The turn about the up axis that best carries the holding fingers from where they are to where
+  // the step takes them, each about their centre (least squares: the angle of the summed cross and
+  // dot products of their offsets from the centres, in the plane across the axis).
+  const Vec3 u = fingersAxis();
+  Vec3 from{0.0}, to{0.0};
+  int count = 0;
+  for (const Finger& f : fingers_) {
+    if (f.grips.empty()) continue;
+    from += f.position;
+    to += f.target;
+    ++count;
+  }
+  if (count < 2) return 0.0;
+  from /= static_cast<Real>(count);
+  to /= static_cast<Real>(count);
+  Real cross = 0.0, dot = 0.0, spread = 0.0;
+  for (const Finger& f : fingers_) {
+    if (f.grips.empty()) continue;
+    Vec3 a = f.position - from, b = f.target - to;
+    a -= u * glm::dot(u, a);
+    b -= u * glm::dot(u, b);
+    cross += glm::dot(u, glm::cross(a, b));
+    dot += glm::dot(a, b);
+    spread += glm::dot(a, a);
+  }
+  // Fingers (nearly) on one spot have no turn to give; nor does a figure that is not finite.
+  if (!(spread > 1e-8) || !(dot > 0.0)) return 0.0;
+  const Real angle = std::atan2(cross, dot);
+  return std::isfinite(angle) ? angle : 0.0;
+}
+
 void World::moveFingers(Real h) {
   const Real n = static_cast<Real>(settings_.solver.substeps);
   const Real from = static_cast<Real>(substep_) / n, to = static_cast<Real>(substep_ + 1) / n;
+  // Two fingers or more turn what they hold with them, as a hand's twist turns the cloth under each
+  // fingertip: each grip's offset turns about its finger by the fingers' turn (fingersTwist), a
+  // share of it each substep. (Held without turning, each finger's patch kept its heading while the
+  // cloth around it turned: two fingers turning the desk's cloth a quarter turn stretched the links
+  // around their patches to twice their length.)
+  const Vec3 axis = fingersAxis();
+  const Real twist = fingersTwist();
   for (const Finger& f : fingers_) {
     const Vec3 path = f.target - f.position;
     const Vec3 start = f.position + path * from;
     const Vec3 travel = path * (to - from);
     for (const FingerGrip& grip : f.grips) {
+      const Vec3 offsetFrom = turned(grip.offset, axis, twist * from), offsetTo = turned(grip.offset, axis, twist * to);
       ClothRecord& record = records_[static_cast<std::size_t>(grip.cloth)];
       ParticleState& s = record.cloth.state;
       // Where the cloth cannot tear, a finger cannot hold a particle beyond its tethers (as far from
@@ -997,7 +1058,7 @@ void World::moveFingers(Real h) {
         // It catches up at most half the contact distance a substep faster than the finger moves, so
         // that it is not flung when it comes free (nor when the finger lets go just then).
         const Vec3 x = s.position[grip.particle];
-        Vec3 move = reach(start + travel + grip.offset) - x;
+        Vec3 move = reach(start + travel + offsetTo) - x;
         const Real length = glm::length(move), most = glm::length(travel) + 0.5 * settings_.selfCollision.distance;
         if (length > most) move *= most / length;
         s.previousPosition[grip.particle] = x - move;
@@ -1005,7 +1066,7 @@ void World::moveFingers(Real h) {
       }
       // Set where the finger is at the start of the substep, and one substep's travel behind: the
       // integrator then carries the particle to where the finger is at its end (inverse mass 0).
-      const Vec3 at = reach(start + grip.offset), by = reach(start + travel + grip.offset) - at;
+      const Vec3 at = reach(start + offsetFrom), by = reach(start + travel + offsetTo) - at;
       s.position[grip.particle] = at;
       s.previousPosition[grip.particle] = at - by;
       if (!s.velocity.empty()) s.velocity[grip.particle] = by / h;

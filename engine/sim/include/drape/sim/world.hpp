@@ -307,6 +307,10 @@ class World {
   void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits,
                            const std::vector<ParticleInsert>& inserted = {});
   void moveFingers(Real h);
+  // The turn (radians, about fingersAxis) that best carries the fingers holding something from
+  // their positions to their targets, about their centre; 0 with fewer than two.
+  Real fingersTwist() const;
+  Vec3 fingersAxis() const;
   void tear();
   // Runs `change` (a tear or a cut) on every cloth, and what follows a cloth's change; the cloths
   // it changed.
