@@ -299,6 +299,69 @@ TEST(Finger, TwoFingersTurnWhatTheyHoldWithThem) {
   EXPECT_LT(glm::length(cloth.state.position[cloth.rest.index(15, 15)] - Vec3{1.0, 0.0, 0.0}), 0.01);
 }
 
+TEST(Finger, FingersCloseTogetherOrOnAnotherClothTurnNothing) {
+  // Each finger's grips, as pressed, against where they are after the moves.
+  const auto offsets = [](const World& world, int id) {
+    std::vector<Vec3> out;
+    for (const FingerGrip& grip : world.finger(id)->grips) out.push_back(grip.offset);
+    return out;
+  };
+  {
+    // Two fingers on one sheet closing to pinch, with a sideways miss of half a millimetre: the line
+    // between them turns 27 degrees, nearly all of it in the last steps, where so near each other
+    // (closer than their patches' diameter) a miss is no turn of the hand. What they hold turns
+    // with the line only while they are apart, half a degree (17 degrees or more with the first
+    // version's guard, a spread of 1e-8 m^2).
+    World world(flatSheet(16));
+    const Vec3 middle{0.5, 0.0, 0.5};
+    ASSERT_GT(world.pressFinger(1, middle + Vec3{0.3, 0.0, 0.0}, 0.05), 0);
+    ASSERT_GT(world.pressFinger(2, middle - Vec3{0.3, 0.0, 0.0}, 0.05), 0);
+    const std::vector<Vec3> first = offsets(world, 1), second = offsets(world, 2);
+    for (int step = 1; step <= 30; ++step) {
+      const Real f = step / 30.0;
+      const Vec3 to = Vec3{0.3, 0.0, 0.0} * (1.0 - f) + Vec3{0.001, 0.0, 0.0005} * f;
+      world.moveFinger(1, middle + to);
+      world.moveFinger(2, middle - to);
+      ASSERT_EQ(world.step(), StepStatus::ok);
+    }
+    // How far each grip's offset turned about the up axis (+y).
+    const auto turn = [](const std::vector<Vec3>& now, const std::vector<Vec3>& was) {
+      Real most = 0.0;
+      for (std::size_t k = 0; k < now.size(); ++k) {
+        const Real a = std::atan2(now[k].x, now[k].z) - std::atan2(was[k].x, was[k].z);
+        most = std::max(most, std::abs(std::remainder(a, 2.0 * 3.14159265358979)));
+      }
+      return most;
+    };
+    EXPECT_LT(turn(offsets(world, 1), first), 0.02);
+    EXPECT_LT(turn(offsets(world, 2), second), 0.02);
+  }
+  {
+    // A finger on each of two sheets, swung round their common middle: two hands of one finger
+    // each, which turn nothing.
+    WorldSettings settings = flatSheet(16);
+    ClothSettings other = settings.cloths[0];
+    other.lattice.origin = Vec3{2.0, 0.0, 0.0};
+    settings.cloths.push_back(other);
+    World world(settings);
+    const Vec3 middle{1.5, 0.0, 0.5};
+    ASSERT_GT(world.pressFinger(1, middle - Vec3{1.0, 0.0, 0.0}, 0.1), 0);
+    ASSERT_GT(world.pressFinger(2, middle + Vec3{1.0, 0.0, 0.0}, 0.1), 0);
+    ASSERT_EQ(world.finger(1)->grips.front().cloth, 0);
+    ASSERT_EQ(world.finger(2)->grips.front().cloth, 1);
+    const std::vector<Vec3> first = offsets(world, 1), second = offsets(world, 2);
+    for (int step = 1; step <= 30; ++step) {
+      const Real a = 0.5 * step / 30.0;
+      const Vec3 arm{std::cos(a), 0.0, -std::sin(a)};
+      world.moveFinger(1, middle - arm);
+      world.moveFinger(2, middle + arm);
+      ASSERT_EQ(world.step(), StepStatus::ok);
+    }
+    EXPECT_EQ(offsets(world, 1), first);
+    EXPECT_EQ(offsets(world, 2), second);
+  }
+}
+
 // A sheet pinned along x = 0, pulled by a finger along its far edge until it tears.
 World pulledApart(Real threshold, int steps) {
   WorldSettings settings = flatSheet(11);

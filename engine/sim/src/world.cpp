@@ -40,6 +40,9 @@ Vec3 turned(const Vec3& v, const Vec3& u, Real angle) {
 }
 
 constexpr Real kLargest = std::numeric_limits<Real>::max();
+// The most a hand of fingers turns what it holds in one step, radians (fingersTwist): 15 degrees a
+// frame at 60 frames a second, far past a wrist's turn.
+constexpr Real kMostTwist = 0.25;
 bool finite(Real value) { return std::isfinite(value); }
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -788,13 +791,14 @@ StepStatus World::step() {
     for (Collider& collider : colliders_) collider.setTime(time());  // back where the last good positions saw them
     return StepStatus::diverged;
   }
-  // The grips keep the turn the step gave them (moveFingers).
-  const Real twist = fingersTwist();
-  if (twist != 0.0) {
-    const Vec3 axis = fingersAxis();
-    for (Finger& finger : fingers_) {
-      for (FingerGrip& grip : finger.grips) grip.offset = turned(grip.offset, axis, twist);
-    }
+  // The grips keep the turn the step gave them (moveFingers), each hand's worked out before any
+  // of its offsets turn.
+  std::vector<Real> twists;
+  for (const Finger& finger : fingers_) twists.push_back(fingersTwist(finger));
+  const Vec3 axis = fingersAxis();
+  for (std::size_t k = 0; k < fingers_.size(); ++k) {
+    if (twists[k] == 0.0) continue;
+    for (FingerGrip& grip : fingers_[k].grips) grip.offset = turned(grip.offset, axis, twists[k]);
   }
   for (Finger& finger : fingers_) finger.position = finger.target;
   ++stepCount_;
@@ -990,36 +994,54 @@ Vec3 World::fingersAxis() const {
   return g > 0.0 && std::isfinite(g) ? -settings_.gravity / g : Vec3{0.0, 1.0, 0.0};
 }
 
-Real World::fingersTwist() const {
-  // The turn about the up axis that best carries the holding fingers from where they are to where
-  // the step takes them, each about their centre (least squares: the angle of the summed cross and
-  // dot products of their offsets from the centres, in the plane across the axis).
+Real World::fingersTwist(const Finger& finger) const {
+  // The fingers that turn together: those holding the same piece of the same cloth as this one
+  // (fingers on another cloth or piece are another hand's). The turn about the up axis that best
+  // carries them from where they are to where the step takes them, each about their centre (least
+  // squares: the angle of the summed cross and dot products of their offsets from the centres, in
+  // the plane across the axis).
+  if (finger.grips.empty()) return 0.0;
+  const auto handOf = [&](const Finger& f) {
+    const FingerGrip& g = f.grips.front();
+    const Cloth& cloth = records_[static_cast<std::size_t>(g.cloth)].cloth;
+    return std::pair<int, std::uint32_t>{g.cloth, cloth.pieceOf(g.particle)};
+  };
+  const auto hand = handOf(finger);
+  const auto inHand = [&](const Finger& f) { return !f.grips.empty() && handOf(f) == hand; };
   const Vec3 u = fingersAxis();
   Vec3 from{0.0}, to{0.0};
+  Real radius = 0.0;
   int count = 0;
   for (const Finger& f : fingers_) {
-    if (f.grips.empty()) continue;
+    if (!inHand(f)) continue;
     from += f.position;
     to += f.target;
+    radius += f.radius;
     ++count;
   }
   if (count < 2) return 0.0;
   from /= static_cast<Real>(count);
   to /= static_cast<Real>(count);
-  Real cross = 0.0, dot = 0.0, spread = 0.0;
+  radius /= static_cast<Real>(count);
+  Real cross = 0.0, dot = 0.0, spreadFrom = 0.0, spreadTo = 0.0;
   for (const Finger& f : fingers_) {
-    if (f.grips.empty()) continue;
+    if (!inHand(f)) continue;
     Vec3 a = f.position - from, b = f.target - to;
     a -= u * glm::dot(u, a);
     b -= u * glm::dot(u, b);
     cross += glm::dot(u, glm::cross(a, b));
     dot += glm::dot(a, b);
-    spread += glm::dot(a, a);
+    spreadFrom += glm::dot(a, a);
+    spreadTo += glm::dot(b, b);
   }
-  // Fingers (nearly) on one spot have no turn to give; nor does a figure that is not finite.
-  if (!(spread > 1e-8) || !(dot > 0.0)) return 0.0;
+  // Fingers nearer each other across the axis than about a patch's diameter (two fingers closing
+  // to pinch) have no turn to give: there a sideways miss of a millimetre would read as a large
+  // turn. Nor has a move that turns them a quarter turn or more in one step (which way is not
+  // told), or a figure that is not finite. And at most kMostTwist a step.
+  const Real least = static_cast<Real>(count) * radius * radius;
+  if (!(spreadFrom >= least) || !(spreadTo >= least) || !(dot > 0.0)) return 0.0;
   const Real angle = std::atan2(cross, dot);
-  return std::isfinite(angle) ? angle : 0.0;
+  return std::isfinite(angle) ? std::clamp(angle, -kMostTwist, kMostTwist) : 0.0;
 }
 
 void World::moveFingers(Real h) {
@@ -1031,8 +1053,8 @@ void World::moveFingers(Real h) {
   // cloth around it turned: two fingers turning the desk's cloth a quarter turn stretched the links
   // around their patches to twice their length.)
   const Vec3 axis = fingersAxis();
-  const Real twist = fingersTwist();
   for (const Finger& f : fingers_) {
+    const Real twist = fingersTwist(f);
     const Vec3 path = f.target - f.position;
     const Vec3 start = f.position + path * from;
     const Vec3 travel = path * (to - from);
@@ -1059,7 +1081,8 @@ void World::moveFingers(Real h) {
         // that it is not flung when it comes free (nor when the finger lets go just then).
         const Vec3 x = s.position[grip.particle];
         Vec3 move = reach(start + travel + offsetTo) - x;
-        const Real length = glm::length(move), most = glm::length(travel) + 0.5 * settings_.selfCollision.distance;
+        const Real length = glm::length(move),
+                   most = glm::length(travel + offsetTo - offsetFrom) + 0.5 * settings_.selfCollision.distance;
         if (length > most) move *= most / length;
         s.previousPosition[grip.particle] = x - move;
         continue;

@@ -109,8 +109,10 @@ void settleHeldSpan(const DistanceConstraint* link, std::size_t first, std::size
       const DistanceConstraint& c = link[first + i];
       const Vec3 d = x[c.b] - x[c.a] + move[i + 1] - move[i];
       // A link the step turns round (its particle carried through its neighbour) may come out its
-      // length, but the cloth is folded through itself there: no such step is taken.
-      if (!(glm::dot(d, normalOf(i)) > 0.0)) return std::numeric_limits<Real>::infinity();
+      // length, but the cloth is folded through itself there: no such step is taken. (A link whose
+      // particles coincide has no direction, and no way round to be turned.)
+      const Vec3 along = normalOf(i);
+      if (glm::dot(along, along) > 0.0 && !(glm::dot(d, along) > 0.0)) return std::numeric_limits<Real>::infinity();
       const Real e = glm::length(d) - c.restLength + alphaTilde * lambdaOf(i);
       sum += compliant ? e * e / (2.0 * alphaTilde) : e * e;
     }

@@ -307,9 +307,12 @@ class World {
   void afterTopologyChange(std::size_t cloth, const std::vector<ParticleSplit>& splits,
                            const std::vector<ParticleInsert>& inserted = {});
   void moveFingers(Real h);
-  // The turn (radians, about fingersAxis) that best carries the fingers holding something from
-  // their positions to their targets, about their centre; 0 with fewer than two.
-  Real fingersTwist() const;
+  // The turn (radians, about fingersAxis) that best carries `finger`'s hand (the fingers holding the
+  // same piece of the same cloth) from their positions to their targets, about their centre. 0
+  // where it holds nothing, its hand is one finger, its fingers are closer together than about a
+  // patch's diameter, or the move turns them a quarter turn or more; at most kMostTwist.
+  Real fingersTwist(const Finger& finger) const;
+  // The axis hands turn about: against gravity, or +y without it.
   Vec3 fingersAxis() const;
   void tear();
   // Runs `change` (a tear or a cut) on every cloth, and what follows a cloth's change; the cloths
