@@ -791,14 +791,13 @@ StepStatus World::step() {
     for (Collider& collider : colliders_) collider.setTime(time());  // back where the last good positions saw them
     return StepStatus::diverged;
   }
-  // The grips keep the turn the step gave them (moveFingers), each hand's worked out before any
-  // of its offsets turn.
-  std::vector<Real> twists;
-  for (const Finger& finger : fingers_) twists.push_back(fingersTwist(finger));
+  // The grips keep the turn the step gave them (moveFingers; the turn reads the fingers' positions
+  // and targets, not the offsets it turns).
   const Vec3 axis = fingersAxis();
-  for (std::size_t k = 0; k < fingers_.size(); ++k) {
-    if (twists[k] == 0.0) continue;
-    for (FingerGrip& grip : fingers_[k].grips) grip.offset = turned(grip.offset, axis, twists[k]);
+  for (Finger& finger : fingers_) {
+    const Real twist = fingersTwist(finger);
+    if (twist == 0.0) continue;
+    for (FingerGrip& grip : finger.grips) grip.offset = turned(grip.offset, axis, twist);
   }
   for (Finger& finger : fingers_) finger.position = finger.target;
   ++stepCount_;
@@ -1051,7 +1050,7 @@ void World::moveFingers(Real h) {
   // fingertip: each grip's offset turns about its finger by the fingers' turn (fingersTwist), a
   // share of it each substep. (Held without turning, each finger's patch kept its heading while the
   // cloth around it turned: two fingers turning the desk's cloth a quarter turn stretched the links
-  // around their patches to twice their length.)
+  // around their patches to 2.4 times their length.)
   const Vec3 axis = fingersAxis();
   for (const Finger& f : fingers_) {
     const Real twist = fingersTwist(f);

@@ -89,8 +89,9 @@ void settleHeldSpan(const DistanceConstraint* link, std::size_t first, std::size
   const bool compliant = alphaTilde > 0.0;
   const auto lambdaOf = [&](std::size_t i) { return lambda ? lambda[first + i] : 0.0; };
   const auto normalOf = [&](std::size_t i) { return normal[(first + i) * stride]; };
-  // The measure after the moves of the multipliers' steps dl[0, m).
-  const auto measure = [&](const Real* dl) {
+  // The measure after the moves of the multipliers' steps dl[0, m); and, if asked, the links'
+  // errors (XPBD: with their compliance's share) added up.
+  const auto measure = [&](const Real* dl, Real* errors = nullptr) {
     scratch.move.assign(m + 1, Vec3{0.0});
     Vec3* move = scratch.move.data();
     for (std::size_t i = 0; i < m; ++i) {
@@ -114,6 +115,7 @@ void settleHeldSpan(const DistanceConstraint* link, std::size_t first, std::size
       const Vec3 along = normalOf(i);
       if (glm::dot(along, along) > 0.0 && !(glm::dot(d, along) > 0.0)) return std::numeric_limits<Real>::infinity();
       const Real e = glm::length(d) - c.restLength + alphaTilde * lambdaOf(i);
+      if (errors) *errors += e;
       sum += compliant ? e * e / (2.0 * alphaTilde) : e * e;
     }
     return sum;
@@ -122,13 +124,8 @@ void settleHeldSpan(const DistanceConstraint* link, std::size_t first, std::size
   Real* dl = scratch.step.data();
   Real* upper = dl + m;
   Real* even = dl + 2 * m;
-  const Real before = measure(dl);  // (no step)
-  // Each link's error (XPBD: with its compliance's share), and the span's mean.
-  Real mean = 0.0;
-  for (std::size_t i = 0; i < m; ++i) {
-    const DistanceConstraint& c = link[first + i];
-    mean += glm::length(x[c.b] - x[c.a]) - c.restLength + alphaTilde * lambdaOf(i);
-  }
+  Real mean = 0.0;                         // the span's mean error, as it is
+  const Real before = measure(dl, &mean);  // (no step)
   mean /= static_cast<Real>(m);
   // Thomas' algorithm on the span's rows with mu on the diagonal, as solveLines' (its ends held:
   // nothing couples beyond), for each link's error less `shift`, into out; a pivot the system
