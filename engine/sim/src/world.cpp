@@ -618,7 +618,7 @@ void World::positionSubstep(Real h) {
   });
   timed(Stage::collide, [&](PartClock&) {
     moveColliders();
-    for (ClothRecord& record : records_) contact::detect(record.cloth, colliders_, record.work->solver);
+    for (ClothRecord& record : records_) contact::detect(record.cloth, colliders_, record.work->solver, workers_.get());
   });
   timed(Stage::projectConstraints, [&](PartClock& parts) {
     for (std::size_t c = 0; c < records_.size(); ++c) {
@@ -633,7 +633,8 @@ void World::positionSubstep(Real h) {
     }
   });
   timed(Stage::friction, [&](PartClock&) {
-    for (ClothRecord& record : records_) contact::friction(record.cloth, colliders_, substep.h, record.work->solver);
+    for (ClothRecord& record : records_)
+      contact::friction(record.cloth, colliders_, substep.h, record.work->solver, workers_.get());
   });
   timed(Stage::selfContact, [&](PartClock& parts) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
@@ -642,7 +643,7 @@ void World::positionSubstep(Real h) {
     if (!colliders_.empty()) {
       parts.time(Stage::friction, [&] {
         for (ClothRecord& record : records_)
-          contact::friction(record.cloth, colliders_, substep.h, record.work->solver);
+          contact::friction(record.cloth, colliders_, substep.h, record.work->solver, workers_.get());
       });
     }
     selfContact_->finish(records_, settings_.selfCollision, *workers_, &parts);

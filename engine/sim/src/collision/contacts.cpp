@@ -63,9 +63,24 @@ Candidate touch(const Collider& collider, int index, Vec3 previous, Vec3 to, Rea
   return {};
 }
 
+// Each free particle's contact is its own: the loops below go to the workers in blocks of
+// particles, the same bit for bit whatever their number. Below the grain (particles a thread) a
+// loop runs on the caller alone: the projection is a handful of operations a particle, detecting
+// a march along its path. (No workers: the caller alone.)
+constexpr std::size_t kDetectGrain = 256, kProjectGrain = 2048, kFrictionGrain = 1024;
+template <class F>
+void eachParticle(Workers* workers, std::size_t n, std::size_t grain, F&& f) {
+  if (!workers) {
+    f(std::size_t{0}, n);
+    return;
+  }
+  workers->run(
+      n, [&](std::size_t begin, std::size_t end, int) { f(begin, end); }, grain);
+}
+
 }  // namespace
 
-void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch& scratch) {
+void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch& scratch, Workers* workers) {
   ParticleState& s = cloth.state;
   const std::size_t n = s.position.size();
   if (scratch.contactCollider.size() != n) {
@@ -76,66 +91,72 @@ void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch&
     scratch.contactRub.assign(n, Vec3{0.0});
   }
   const Real thickness = cloth.settings.thickness;
-  for (std::size_t i = 0; i < n; ++i) {
-    scratch.contactCollider[i] = -1;
-    if (s.inverseMass[i] == 0.0) continue;
-    Real deepest = -std::numeric_limits<Real>::infinity();
-    for (std::size_t c = 0; c < colliders.size(); ++c) {
-      const Candidate candidate =
-          touch(colliders[c], static_cast<int>(c), s.previousPosition[i], s.position[i], thickness);
-      if (candidate.collider < 0) continue;
-      const Real depth = candidate.offset - glm::dot(candidate.normal, s.position[i]);
-      if (depth <= deepest) continue;
-      deepest = depth;
-      scratch.contactCollider[i] = candidate.collider;
-      scratch.contactNormal[i] = candidate.normal;
-      scratch.contactOffset[i] = candidate.offset;
+  eachParticle(workers, n, kDetectGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      scratch.contactCollider[i] = -1;
+      if (s.inverseMass[i] == 0.0) continue;
+      Real deepest = -std::numeric_limits<Real>::infinity();
+      for (std::size_t c = 0; c < colliders.size(); ++c) {
+        const Candidate candidate =
+            touch(colliders[c], static_cast<int>(c), s.previousPosition[i], s.position[i], thickness);
+        if (candidate.collider < 0) continue;
+        const Real depth = candidate.offset - glm::dot(candidate.normal, s.position[i]);
+        if (depth <= deepest) continue;
+        deepest = depth;
+        scratch.contactCollider[i] = candidate.collider;
+        scratch.contactNormal[i] = candidate.normal;
+        scratch.contactOffset[i] = candidate.offset;
+      }
+      scratch.contactDepth[i] = 0.0;
+      scratch.contactRub[i] = Vec3{0.0};
     }
-    scratch.contactDepth[i] = 0.0;
-    scratch.contactRub[i] = Vec3{0.0};
-  }
-  project(cloth, scratch);
+  });
+  project(cloth, scratch, workers);
 }
 
-void project(Cloth& cloth, SolverScratch& scratch) {
+void project(Cloth& cloth, SolverScratch& scratch, Workers* workers) {
   ParticleState& s = cloth.state;
-  for (std::size_t i = 0; i < scratch.contactCollider.size(); ++i) {
-    if (scratch.contactCollider[i] < 0) continue;
-    const Real gap = glm::dot(scratch.contactNormal[i], s.position[i]) - scratch.contactOffset[i];
-    if (gap < 0.0) {
-      s.position[i] -= scratch.contactNormal[i] * gap;
-      // Every push out counts, also those undoing what the constraints pulled in: the normal force
-      // friction answers to includes the weight of the cloth hanging from this particle.
-      scratch.contactDepth[i] -= gap;
+  eachParticle(workers, scratch.contactCollider.size(), kProjectGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (scratch.contactCollider[i] < 0) continue;
+      const Real gap = glm::dot(scratch.contactNormal[i], s.position[i]) - scratch.contactOffset[i];
+      if (gap < 0.0) {
+        s.position[i] -= scratch.contactNormal[i] * gap;
+        // Every push out counts, also those undoing what the constraints pulled in: the normal force
+        // friction answers to includes the weight of the cloth hanging from this particle.
+        scratch.contactDepth[i] -= gap;
+      }
     }
-  }
+  });
 }
 
-void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch) {
+void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch, Workers* workers) {
   ParticleState& s = cloth.state;
-  for (std::size_t i = 0; i < scratch.contactCollider.size(); ++i) {
-    const int c = scratch.contactCollider[i];
-    const Real depth = scratch.contactDepth[i];
-    if (c < 0 || depth <= 0.0) continue;
-    const Vec3 n = scratch.contactNormal[i];
-    if (glm::dot(n, s.position[i]) - scratch.contactOffset[i] > 1e-9) continue;  // lifted off
-    const Friction& f = colliders[static_cast<std::size_t>(c)].settings().friction;
-    const Vec3 relative = (s.position[i] - s.previousPosition[i]) -
-                          colliders[static_cast<std::size_t>(c)].surfaceVelocity(s.position[i]) * h;
-    const Vec3 tangential = relative - n * glm::dot(n, relative);
-    // The friction so far is part of that motion: without it the particle would have moved `free`.
-    Vec3& rub = scratch.contactRub[i];
-    const Vec3 free = tangential - rub;
-    const Real length = glm::length(free);
-    Vec3 next{0.0};  // the friction's whole correction this substep, after this call
-    if (length < f.staticCoefficient * depth) {
-      next = -free;  // stuck: back where the substep began, relative to the surface
-    } else if (length > 0.0) {
-      next = free * -std::min(f.kineticCoefficient * depth / length, Real{1.0});
+  eachParticle(workers, scratch.contactCollider.size(), kFrictionGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const int c = scratch.contactCollider[i];
+      const Real depth = scratch.contactDepth[i];
+      if (c < 0 || depth <= 0.0) continue;
+      const Vec3 n = scratch.contactNormal[i];
+      if (glm::dot(n, s.position[i]) - scratch.contactOffset[i] > 1e-9) continue;  // lifted off
+      const Friction& f = colliders[static_cast<std::size_t>(c)].settings().friction;
+      const Vec3 relative = (s.position[i] - s.previousPosition[i]) -
+                            colliders[static_cast<std::size_t>(c)].surfaceVelocity(s.position[i]) * h;
+      const Vec3 tangential = relative - n * glm::dot(n, relative);
+      // The friction so far is part of that motion: without it the particle would have moved `free`.
+      Vec3& rub = scratch.contactRub[i];
+      const Vec3 free = tangential - rub;
+      const Real length = glm::length(free);
+      Vec3 next{0.0};  // the friction's whole correction this substep, after this call
+      if (length < f.staticCoefficient * depth) {
+        next = -free;  // stuck: back where the substep began, relative to the surface
+      } else if (length > 0.0) {
+        next = free * -std::min(f.kineticCoefficient * depth / length, Real{1.0});
+      }
+      s.position[i] += next - rub;
+      rub = next;
     }
-    s.position[i] += next - rub;
-    rub = next;
-  }
+  });
 }
 
 void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch) {

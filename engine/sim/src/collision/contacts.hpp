@@ -22,8 +22,10 @@
 
 namespace drape::sim::contact {
 
-void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch& scratch);
-void project(Cloth& cloth, SolverScratch& scratch);
+// (With `workers`, detect, project and friction share the particles among them: each particle's
+// contact is its own, so the result is the same whatever their number.)
+void detect(Cloth& cloth, const std::vector<Collider>& colliders, SolverScratch& scratch, Workers* workers = nullptr);
+void project(Cloth& cloth, SolverScratch& scratch, Workers* workers = nullptr);
 // Static while the tangential motion relative to the surface is below mu_s times the penetration
 // resolved this substep (by the first projection and by every re-projection after a sweep), else reduced by mu_k times
 // it: on a slope a particle sticks when tan(theta) < mu_s and slides with a = g (sin(theta) - mu_k cos(theta))
@@ -32,7 +34,8 @@ void project(Cloth& cloth, SolverScratch& scratch);
 // have made without friction and stays within mu times the penetration resolved so far, however many calls. The
 // sweeps after it then see a stuck particle where it sticks, and do not pull on it a correction the friction takes
 // back at the end (which left the links over a table's edge 30-50 % long at 64 x 64).
-void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch);
+void friction(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch,
+              Workers* workers = nullptr);
 // Force model: project onto the contact planes, remove the normal velocity into the surface, and
 // reduce the tangential velocity by Coulomb friction with the impulse that took.
 void respondWithVelocities(Cloth& cloth, const std::vector<Collider>& colliders, Real h, SolverScratch& scratch);

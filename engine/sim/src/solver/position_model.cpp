@@ -574,8 +574,8 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Subste
     if (!scratch.layerContacts.empty()) parts.time(Stage::layerContacts, [&] { holdLayers(cloth, scratch); });
     if (!colliders.empty()) {
       parts.time(Stage::contactPlanes, [&] {
-        contact::project(cloth, scratch);
-        contact::friction(cloth, colliders, substep.h, scratch);
+        contact::project(cloth, scratch, &workers);
+        contact::friction(cloth, colliders, substep.h, scratch, &workers);
       });
     }
   }
