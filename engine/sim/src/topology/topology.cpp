@@ -149,9 +149,29 @@ void rebuildConstraints(Cloth& cloth) {
     if (a == b) continue;
     made.push_back({x.kind, std::min(a, b), std::max(a, b), i});
   }
-  std::sort(made.begin(), made.end(), [](const Made& l, const Made& r) {
-    return std::tie(l.kind, l.a, l.b, l.from) < std::tie(r.kind, r.a, r.b, r.from);
-  });
+  // In order of kind, a, b and template (the templates come in order): counted out by kind and a
+  // (which keeps the templates' order), then each particle's few by b. A rebuild follows every
+  // breaking pass; sorting the whole list by comparison took 40 % of the desk tear's tearing time
+  // at 64 x 64, a quarter at 128 x 128.
+  {
+    const std::size_t particles = cloth.rest.particleCount();
+    const auto bucket = [&](const Made& m) { return static_cast<std::size_t>(m.kind) * particles + m.a; };
+    std::vector<std::uint32_t> start(kConstraintKindCount * particles + 1, 0);
+    for (const Made& m : made) ++start[bucket(m) + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    std::vector<Made> sorted(made.size());
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (const Made& m : made) sorted[fill[bucket(m)]++] = m;
+    for (std::size_t k = 0; k + 1 < start.size(); ++k) {
+      for (std::size_t i = start[k] + 1; i < start[k + 1]; ++i) {  // insertion: stable, and a fan is short
+        const Made m = sorted[i];
+        std::size_t j = i;
+        for (; j > start[k] && m.b < sorted[j - 1].b; --j) sorted[j] = sorted[j - 1];
+        sorted[j] = m;
+      }
+    }
+    made.swap(sorted);
+  }
   made.erase(std::unique(made.begin(), made.end(),
                          [](const Made& l, const Made& r) { return l.kind == r.kind && l.a == r.a && l.b == r.b; }),
              made.end());
