@@ -76,8 +76,12 @@ int signChangesIn01(const std::array<Real, 4>& c, std::array<Real, 3>& roots) {
   }
   return found;
 }
-// Two points closer than this at x0 give no direction to keep apart along.
+// Two points closer than this at x0 give no direction to keep apart along (a closed seam aside:
+// SelfContact::measure).
 constexpr Real kCoincident = 1e-12;
+// How far the contacts' sweep parts a closed seam's two sides where they meet (m): 168 points of
+// the exact test's grid, far under what the eye or the contact distance sees.
+constexpr Real kSeamApart = 1e-5;
 // A pair's separation where nothing is proven.
 constexpr float kUnproven = -std::numeric_limits<float>::infinity();
 // How many times its rest size a triangle or edge may be stretched and still take part (longer
@@ -955,6 +959,33 @@ SelfContact::Contact SelfContact::measure(Pair& pair, Real distance) const {
     pair.rest = rest < distance ? kRestNear : kRestApart;
     contact.target = std::min(distance, rest);
   }
+  // The two sides of a closed seam (a tear's or a cut's copies, still on the same points) have no
+  // line between them to be kept apart along: they part along the line from the second side's
+  // triangles to the first's, and by kSeamApart. Without it the sweeps drew a seam lying flat on the
+  // table into an overlap of its own two sides, which the fail-safe sent back to x0 every substep
+  // after: a shred of the desk's tear lay frozen with a link 64 % long (docs/design.md).
+  if (!(contact.gap0 > kCoincident) && pair.rest == kRestNear) {
+    const auto centreOf = [&](const std::uint32_t* triangles, std::size_t count) {
+      Vec3 sum{0.0};
+      Real used = 0.0;
+      for (std::size_t i = 0; i < count; ++i) {
+        if (triangles[i] == kNone) continue;
+        const glm::uvec3 t = triangles_[triangles[i]];
+        sum += x0_[t[0]] + x0_[t[1]] + x0_[t[2]];
+        used += 3.0;
+      }
+      return used > 0.0 ? sum / used : Vec3{0.0};
+    };
+    const Vec3 first = pair.edges ? centreOf(&edgeTriangles_[2 * pair.first], 2)
+                                  : centreOf(&vertexTriangles_[vertexStart_[pair.first]],
+                                             vertexStart_[pair.first + 1] - vertexStart_[pair.first]);
+    const Vec3 second = pair.edges ? centreOf(&edgeTriangles_[2 * pair.second], 2) : centreOf(&pair.second, 1);
+    const Real length = glm::length(first - second);
+    if (length > kCoincident) {
+      contact.normal = (first - second) / length;
+      contact.target = std::max(contact.target, kSeamApart);
+    }
+  }
   return contact;
 }
 
@@ -1057,7 +1088,8 @@ void SelfContact::sweep(Real distance, Real friction, std::vector<ClothRecord>& 
   active_.clear();
   for (std::uint32_t i = 0; i < contacts_.size(); ++i) {
     const Contact& p = contacts_[i];
-    if (p.gap0 > kCoincident && gapNow(p) < distance) active_.push_back(i);
+    // (A contact with a line to push along: apart at x0, or a closed seam's two sides.)
+    if (p.gap0 >= 0.0 && glm::dot(p.normal, p.normal) > 0.0 && gapNow(p) < distance) active_.push_back(i);
   }
   const std::vector<std::uint32_t>& active = active_;
   for (int sweep = 0; sweep < kSweeps; ++sweep) {
