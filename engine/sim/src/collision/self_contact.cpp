@@ -965,7 +965,8 @@ SelfContact::Contact SelfContact::measure(Pair& pair, Real distance) const {
   // table into an overlap of its own two sides, which the fail-safe sent back to x0 every substep
   // after: a shred of the desk's tear lay frozen with a link 64 % long (docs/design.md).
   if (!(contact.gap0 > kCoincident) && pair.rest == kRestNear) {
-    const auto centreOf = [&](const std::uint32_t* triangles, std::size_t count) {
+    // The centre of a side's triangles at x0; none for a particle in no triangle (a chain's).
+    const auto centreOf = [&](const std::uint32_t* triangles, std::size_t count) -> std::optional<Vec3> {
       Vec3 sum{0.0};
       Real used = 0.0;
       for (std::size_t i = 0; i < count; ++i) {
@@ -974,15 +975,17 @@ SelfContact::Contact SelfContact::measure(Pair& pair, Real distance) const {
         sum += x0_[t[0]] + x0_[t[1]] + x0_[t[2]];
         used += 3.0;
       }
-      return used > 0.0 ? sum / used : Vec3{0.0};
+      if (!(used > 0.0)) return std::nullopt;
+      return sum / used;
     };
-    const Vec3 first = pair.edges ? centreOf(&edgeTriangles_[2 * pair.first], 2)
-                                  : centreOf(&vertexTriangles_[vertexStart_[pair.first]],
-                                             vertexStart_[pair.first + 1] - vertexStart_[pair.first]);
-    const Vec3 second = pair.edges ? centreOf(&edgeTriangles_[2 * pair.second], 2) : centreOf(&pair.second, 1);
-    const Real length = glm::length(first - second);
+    const std::optional<Vec3> first = pair.edges ? centreOf(&edgeTriangles_[2 * pair.first], 2)
+                                                 : centreOf(&vertexTriangles_[vertexStart_[pair.first]],
+                                                            vertexStart_[pair.first + 1] - vertexStart_[pair.first]);
+    const std::optional<Vec3> second =
+        pair.edges ? centreOf(&edgeTriangles_[2 * pair.second], 2) : centreOf(&pair.second, 1);
+    const Real length = first && second ? glm::length(*first - *second) : 0.0;
     if (length > kCoincident) {
-      contact.normal = (first - second) / length;
+      contact.normal = (*first - *second) / length;
       contact.target = std::max(contact.target, kSeamApart);
     }
   }

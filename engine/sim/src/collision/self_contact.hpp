@@ -10,8 +10,10 @@
 //    apart along the line between the two primitives' centres.
 // 2. Contacts. For each pair, the closest points at x0 (barycentric on the triangle, or along the
 //    two edges) and the direction between them, n. The contact keeps the two points at least the
-//    target apart along n: `distance`, or less for parts of one cloth closer than that at rest. It
-//    is linear in the positions, C(x) = sum_k c_k (n . x_k) - target >= 0 with sum_k c_k = 0, and
+//    target apart along n: `distance`, or less for parts of one cloth closer than that at rest (a
+//    closed seam, its two sides on the same points, parts along the line between its sides'
+//    triangles, by kSeamApart). It is linear in the positions, C(x) = sum_k c_k (n . x_k) - target
+//    >= 0 with sum_k c_k = 0, and
 //    projected a few sweeps, mass-weighted: linear momentum is kept exactly (to rounding), except
 //    where that would move a particle far more than the points part (kContactLeverage, contacts.hpp). A pair whose
 //    corners lie more than `distance` apart along the line between its centres, or else along the
