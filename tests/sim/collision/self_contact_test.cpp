@@ -592,6 +592,9 @@ TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
     EXPECT_EQ(after, listed(fresh));
   };
   check({24}, 1, 1);  // the middle of the upper sheet: one particle of 130, a refresh
+  // Seven particles spread over the sheet, still a refresh: their triangles and edges walk the
+  // broad phase's tree in clusters of neighbours, and find what a search does.
+  check({3, 10, 17, 24, 31, 38, 45}, 1, 1);
   std::vector<std::size_t> many;
   for (std::size_t i = 0; i < 20; ++i) many.push_back(i + 14);  // 20 particles: a search
   check(many, 2, 0);

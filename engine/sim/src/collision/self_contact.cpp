@@ -101,6 +101,9 @@ constexpr std::size_t kLeafPairBlock = 256;
 // A refresh's primitives a block (the strays' vertices, triangles and edges, each walked down the
 // tree): a few hundred pairs each.
 constexpr std::size_t kRefreshBlock = 64;
+// How far a cluster of a refresh's primitives, walked down the tree as one, may spread: the sum of
+// its box's sides, at most this times its largest member's.
+constexpr float kClusterSpread = 2.0f;
 
 // Closest point of triangle abc to p, as barycentric weights of a, b, c (by the triangle's Voronoi
 // regions: a corner, an edge, or the inside).
@@ -231,7 +234,8 @@ std::size_t SelfContact::bytes() const {
                       b(hits_) + b(slot0_) + b(slotX_) + b(which0_) + b(whichX_) + b(made0_) + b(madeX_) +
                       b(affected_) + b(movedTriangles_) + b(primitiveMoved_) + b(strays_) + b(walk_) + b(refreshed_);
   total += b(nodes_) + b(leafTriangleStart_) + b(leafTriangles_) + b(leafVertexStart_) + b(leafVertices_) +
-           b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(leafPairs_) + b(walkTests_) + b(boxTests_);
+           b(leafEdgeStart_) + b(leafEdges_) + b(leafNode_) + b(primitiveLeaf_) + b(leafPairs_) + b(walkTests_) +
+           b(boxTests_);
   for (const std::vector<std::uint64_t>& walked : walked_) total += b(walked);
   for (const std::vector<Pair>& found : found_) total += b(found);
   for (const std::vector<std::uint64_t>& found : scanTests_) total += b(found);
@@ -381,10 +385,16 @@ void SelfContact::buildTree() {
     std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
     for (std::size_t i = 0; i < count; ++i) members[fill[leafOf(i)]++] = static_cast<std::uint32_t>(i);
   };
-  group(leafVertexStart_, leafVertices_, n, [&](std::size_t v) {
+  const auto vertexLeaf = [&](std::size_t v) {
     return vertexStart_[v] != vertexStart_[v + 1] ? leafOfItem[vertexTriangles_[vertexStart_[v]]] : leafOfItem[nt + v];
-  });
-  group(leafEdgeStart_, leafEdges_, edges_.size(), [&](std::size_t e) { return leafOfItem[edgeTriangles_[2 * e]]; });
+  };
+  const auto edgeLeaf = [&](std::size_t e) { return leafOfItem[edgeTriangles_[2 * e]]; };
+  group(leafVertexStart_, leafVertices_, n, vertexLeaf);
+  group(leafEdgeStart_, leafEdges_, edges_.size(), edgeLeaf);
+  primitiveLeaf_.resize(n + nt + edges_.size());
+  for (std::size_t v = 0; v < n; ++v) primitiveLeaf_[v] = vertexLeaf(v);
+  for (std::size_t t = 0; t < nt; ++t) primitiveLeaf_[n + t] = leafOfItem[t];
+  for (std::size_t e = 0; e < edges_.size(); ++e) primitiveLeaf_[n + nt + e] = edgeLeaf(e);
 }
 
 void SelfContact::fitTree() {
@@ -774,22 +784,72 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays, Workers& wor
         found.swap(found_[begin / kRefreshBlock]);
         found.clear();
         std::int64_t compared = 0;
-        std::vector<std::uint32_t> walk;
-        // The leaves whose boxes overlap box k, in the tree's order.
-        const auto leaves = [&](std::size_t k, auto&& visit) {
+        // The block's primitives in clusters of neighbours (in the order of their own leaves, so near
+        // one another at rest; a primitive joins the cluster before it while the box around them
+        // all stays within kClusterSpread of its largest member's), each cluster's tree walked once
+        // with that box, for the leaves it overlaps, in the tree's order. A primitive's leaves are
+        // those of its cluster its own box overlaps: the same leaves in the same order as a walk of
+        // its own (a node's box holds its children's, so a leaf its box overlaps was reached), for a
+        // tenth of the walking (a stray particle's triangles and edges walked the same nodes).
+        const std::size_t count = end - begin;
+        std::vector<std::uint32_t> order(count), cluster(count), walk;
+        std::vector<std::uint32_t> candidateStart{0}, candidates;
+        for (std::size_t i = 0; i < count; ++i) order[i] = static_cast<std::uint32_t>(i);
+        std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+          const std::uint32_t la = primitiveLeaf_[refreshed_[begin + a]], lb = primitiveLeaf_[refreshed_[begin + b]];
+          return la < lb || (la == lb && a < b);
+        });
+        const auto extent = [](const glm::vec3& lo, const glm::vec3& hi) {
+          const glm::vec3 size = hi - lo;
+          return size.x + size.y + size.z;
+        };
+        const auto walkCluster = [&](const glm::vec3& lo, const glm::vec3& hi) {
           walk.clear();
           if (!nodes_.empty()) walk.push_back(0);
           while (!walk.empty()) {
             const Node& node = nodes_[walk.back()];
             walk.pop_back();
             ++compared;
-            if (!overlap(node.lower, node.upper, boxLower_[k], boxUpper_[k])) continue;
+            if (!overlap(node.lower, node.upper, lo, hi)) continue;
             if (node.right == kNone) {
-              visit(node.left);
+              candidates.push_back(node.left);
             } else {
               walk.push_back(node.right);
               walk.push_back(node.left);
             }
+          }
+          candidateStart.push_back(static_cast<std::uint32_t>(candidates.size()));
+        };
+        glm::vec3 clusterLo{0.0f}, clusterHi{0.0f};
+        float largest = 0.0f;
+        for (std::size_t j = 0; j < count; ++j) {
+          const std::uint32_t k = refreshed_[begin + order[j]];
+          const glm::vec3 lo = boxLower_[k], hi = boxUpper_[k];
+          const float own = extent(lo, hi);
+          const glm::vec3 unionLo = glm::min(clusterLo, lo), unionHi = glm::max(clusterHi, hi);
+          // (Whatever the clusters, a primitive meets the leaves a walk of its own would: a torn
+          // primitive's empty box or a NaN one overlaps none of its cluster's.)
+          if (j > 0 && extent(unionLo, unionHi) <= kClusterSpread * std::max(largest, own)) {
+            clusterLo = unionLo;
+            clusterHi = unionHi;
+            largest = std::max(largest, own);
+          } else {
+            if (j > 0) walkCluster(clusterLo, clusterHi);
+            clusterLo = lo;
+            clusterHi = hi;
+            largest = own;
+          }
+          cluster[order[j]] = static_cast<std::uint32_t>(candidateStart.size() - 1);
+        }
+        if (count > 0) walkCluster(clusterLo, clusterHi);
+        // The leaves whose boxes overlap box k, in the tree's order (i: its place in the block).
+        const auto leaves = [&](std::size_t k, std::size_t i, auto&& visit) {
+          const std::uint32_t c = cluster[i];
+          for (std::uint32_t j = candidateStart[c]; j < candidateStart[c + 1]; ++j) {
+            const std::uint32_t leaf = candidates[j];
+            const Node& node = nodes_[leafNode_[leaf]];
+            ++compared;
+            if (overlap(node.lower, node.upper, boxLower_[k], boxUpper_[k])) visit(leaf);
           }
         };
         // Listed as a search lists them, far (measured by the fail-safe if it must be), and marked new.
@@ -803,13 +863,13 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays, Workers& wor
         for (std::size_t i = begin; i < end; ++i) {
           const std::uint32_t k = refreshed_[i];
           if (k < n) {
-            leaves(k, [&](std::uint32_t leaf) {
+            leaves(k, i - begin, [&](std::uint32_t leaf) {
               for (std::uint32_t j = leafTriangleStart_[leaf]; j < leafTriangleStart_[leaf + 1]; ++j)
                 vertexTriangle(k, leafTriangles_[j]);
             });
           } else if (k < n + nt) {
             const auto t = static_cast<std::uint32_t>(k - n);
-            leaves(k, [&](std::uint32_t leaf) {
+            leaves(k, i - begin, [&](std::uint32_t leaf) {
               for (std::uint32_t j = leafVertexStart_[leaf]; j < leafVertexStart_[leaf + 1]; ++j) {
                 if (!affected_[leafVertices_[j]]) vertexTriangle(leafVertices_[j], t);
               }
@@ -817,7 +877,7 @@ void SelfContact::refresh(const std::vector<std::uint32_t>& strays, Workers& wor
           } else {
             const auto e = static_cast<std::uint32_t>(k - n - nt);
             const glm::vec3 lo = boxLower_[k], hi = boxUpper_[k];
-            leaves(k, [&](std::uint32_t leaf) {
+            leaves(k, i - begin, [&](std::uint32_t leaf) {
               for (std::uint32_t j = leafEdgeStart_[leaf]; j < leafEdgeStart_[leaf + 1]; ++j) {
                 const std::uint32_t f = leafEdges_[j];
                 if (f == e || (affected_[n + nt + f] && f < e)) continue;

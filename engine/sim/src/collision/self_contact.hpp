@@ -254,6 +254,7 @@ class SelfContact {
   std::vector<std::uint32_t> leafVertexStart_, leafVertices_;     // ... its vertices
   std::vector<std::uint32_t> leafEdgeStart_, leafEdges_;          // ... its edges
   std::vector<std::uint32_t> leafNode_;                           // per leaf, its node
+  std::vector<std::uint32_t> primitiveLeaf_;        // per particle, triangle and edge (as the boxes): its leaf
   std::vector<std::uint64_t> leafPairs_;            // this search's overlapping leaves (lower in the high word)
   std::vector<std::vector<std::uint64_t>> walked_;  // per part of the walk: its overlapping leaves
   std::vector<std::int64_t> walkTests_;             // per thread: node boxes compared in the walk
