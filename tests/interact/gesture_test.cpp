@@ -193,7 +193,9 @@ TEST(Gesture, FoldLaysTheNearHalfOnTopOfTheFarHalf) {
 // answered to the whole push of a substep, and a link stretched around the fold's edge, whose push
 // was the sweep taking it back out of the other layer, held the layers fast: these two runs ended
 // with a link 3.3 and 5.6 times its rest length (a red patch on the fold that stayed). With the
-// push bounded by the distance (self_contact.cpp), every free link ends within 10 %.
+// push bounded by the distance (self_contact.cpp), every free link ended within 10 % (2.2 and
+// 1.8 %); with a sweep of the constraints after the contacts' pushes, and the contacts pushed again
+// from there (World::positionSubstep), within 1.5 % (0.91 and 0.95 %).
 TEST(Gesture, AFoldAt64By64EndsWithNoLinkCaughtStretchedBetweenTheLayers) {
   for (const double scale : {1.0, 1.0 - 1e-9}) {
     char distance[64];
@@ -207,7 +209,7 @@ TEST(Gesture, AFoldAt64By64EndsWithNoLinkCaughtStretchedBetweenTheLayers) {
       const Real length = glm::length(cloth.state.position[c.b] - cloth.state.position[c.a]);
       worst = std::max(worst, length / c.restLength - 1.0);
     }
-    EXPECT_LT(worst, 0.1) << distance;
+    EXPECT_LT(worst, 0.015) << distance;
     EXPECT_EQ(played.worstIntersections, 0u) << distance << " at step " << played.worstStep;
   }
 }
@@ -270,14 +272,17 @@ TEST(Gesture, TearRipsTheClothAndOnePieceIsPickedUpAlone) {
   ASSERT_NE(finger, nullptr);
   ASSERT_FALSE(finger->grips.empty());
   const std::uint32_t lifted = cloth.pieceOf(finger->grips.front().particle);
+  // Every other piece stayed down, none carried up with the lifted one (30 cm up): on the table, or
+  // on another piece there (a flap the pull tore and flipped over the strip beside it lies on it,
+  // bunched up to 6.6 cm high; the render shows it).
   int onTable = 0, others = 0;
   for (std::size_t i = 0; i < cloth.state.position.size(); ++i) {
     if (cloth.pieceOf(i) == lifted) continue;
     ++others;
-    onTable += cloth.state.position[i].y < 0.02;
+    onTable += cloth.state.position[i].y < 0.1;
   }
   EXPECT_GT(others, 100);
-  EXPECT_EQ(onTable, others);  // every other piece stayed down
+  EXPECT_EQ(onTable, others);
   EXPECT_NEAR(cloth.state.position[finger->grips.front().particle].y, 0.305, 1e-6);
   // Where the tear opens, the links near the crack are relaxed outside the substeps; self-contact's
   // fail-safe now takes that move too (World::changeTopology). Before, the opening's two sides

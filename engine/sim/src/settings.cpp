@@ -123,6 +123,7 @@ std::string_view name(Stage stage) {
     case Stage::broadPhase: return "broad phase";
     case Stage::narrowPhase: return "narrow phase";
     case Stage::contactSweep: return "contact sweep";
+    case Stage::sweepAfter: return "sweep after";
     case Stage::failSafe: return "fail-safe";
   }
   return "?";

@@ -640,6 +640,22 @@ void World::positionSubstep(Real h) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
     selfContact_->solve(records_, settings_.selfCollision, topologyVersion_, settings_.solver.substeps - substep_,
                         *workers_, &parts);
+    // Where the contacts pushed, the constraints answer: a sweep of each cloth they pushed, holding
+    // what they pushed (position::sweepAfterContacts), and then the contacts pushed again from
+    // there (SelfContact::pushAgain), so that the fail-safe starts from the layers apart.
+    const bool pushed = std::any_of(records_.begin(), records_.end(),
+                                    [](const ClothRecord& r) { return !r.work->solver.layerContacts.empty(); });
+    if (pushed) {
+      parts.time(Stage::sweepAfter, [&] {
+        PartClock inside;
+        for (ClothRecord& record : records_) {
+          if (record.work->solver.layerContacts.empty()) continue;
+          position::sweepAfterContacts(record.cloth, settings_.solver, substep, record.work->solver, colliders_,
+                                       *workers_, inside);
+        }
+        selfContact_->pushAgain(records_, settings_.selfCollision);
+      });
+    }
     if (!colliders_.empty()) {
       parts.time(Stage::friction, [&] {
         for (ClothRecord& record : records_)

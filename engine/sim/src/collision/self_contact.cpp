@@ -1725,6 +1725,15 @@ void SelfContact::findPairsIfNeeded(std::vector<ClothRecord>& cloths, const Self
   reused_ = false;
 }
 
+void SelfContact::pushAgain(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings) {
+  std::size_t k = 0;
+  for (const ClothRecord& record : cloths) {
+    for (const Vec3& x : record.cloth.state.position) x_[k++] = x;
+  }
+  sweep(settings.distance, 0.0, cloths);
+  scatter(cloths);
+}
+
 void SelfContact::finish(std::vector<ClothRecord>& cloths, const SelfCollisionSettings& settings, Workers& workers,
                          PartClock* clock) {
   PartClock untimed;

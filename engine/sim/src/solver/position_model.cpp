@@ -543,6 +543,28 @@ void sweepInBatches(Cloth& cloth, const Compliances& compliances, const StretchP
 
 }  // namespace
 
+namespace {
+
+// One sweep: every constraint (a line at a time with the lines, else in the seed's order), then
+// the self-contacts held (scratch.layerContacts) and the collider contacts' planes, with friction.
+void sweep(Cloth& cloth, bool lines, const Compliances& compliances, const StretchPlan& plan, const Substep& substep,
+           SolverScratch& scratch, const std::vector<Collider>& colliders, Workers& workers, PartClock& parts) {
+  if (lines) {
+    sweepInBatches(cloth, compliances, plan, scratch, workers, parts);
+  } else {
+    sweepInOrder(cloth, compliances, scratch, parts);
+  }
+  if (!scratch.layerContacts.empty()) parts.time(Stage::layerContacts, [&] { holdLayers(cloth, scratch); });
+  if (!colliders.empty()) {
+    parts.time(Stage::contactPlanes, [&] {
+      contact::project(cloth, scratch, &workers);
+      contact::friction(cloth, colliders, substep.h, scratch, &workers);
+    });
+  }
+}
+
+}  // namespace
+
 void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Substep& substep, SolverScratch& scratch,
                         const std::vector<Collider>& colliders, Workers& workers, PartClock& parts) {
   const Compliances compliances = compliancesOf(cloth, solver, substep.h);
@@ -566,19 +588,15 @@ void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Subste
     // since, and with the geometric stiffness it makes those grow too. The trampoline at 8 sweeps
     // summed over all of them blew up in four frames.
     scratch.sumTension = iteration == 0;
-    if (solver.lines()) {
-      sweepInBatches(cloth, compliances, plan, scratch, workers, parts);
-    } else {
-      sweepInOrder(cloth, compliances, scratch, parts);
-    }
-    if (!scratch.layerContacts.empty()) parts.time(Stage::layerContacts, [&] { holdLayers(cloth, scratch); });
-    if (!colliders.empty()) {
-      parts.time(Stage::contactPlanes, [&] {
-        contact::project(cloth, scratch, &workers);
-        contact::friction(cloth, colliders, substep.h, scratch, &workers);
-      });
-    }
+    sweep(cloth, solver.lines(), compliances, plan, substep, scratch, colliders, workers, parts);
   }
+}
+
+void sweepAfterContacts(Cloth& cloth, const SolverSettings& solver, const Substep& substep, SolverScratch& scratch,
+                        const std::vector<Collider>& colliders, Workers& workers, PartClock& parts) {
+  scratch.sumTension = false;
+  sweep(cloth, solver.lines(), compliancesOf(cloth, solver, substep.h), stretchPlan(cloth, solver, scratch), substep,
+        scratch, colliders, workers, parts);
 }
 
 void dampConstraints(Cloth& cloth, const SolverScratch& scratch) {

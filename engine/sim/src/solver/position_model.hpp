@@ -64,6 +64,13 @@ void integrate(Cloth& cloth, const Substep& substep, const std::vector<Vec3>* ex
 void projectConstraints(Cloth& cloth, const SolverSettings& solver, const Substep& substep, SolverScratch& scratch,
                         const std::vector<Collider>& colliders, Workers& workers, PartClock& parts);
 
+// One more sweep of projectConstraints' kind, after self-contact pushed (World::positionSubstep):
+// every constraint, then the contacts self-contact just pushed (scratch.layerContacts, now this
+// substep's) held, then the collider contacts' planes. Nothing is reset: with XPBD the multipliers
+// go on adding up, as over the substep's sweeps. (Self-contact then pushes its contacts again.)
+void sweepAfterContacts(Cloth& cloth, const SolverSettings& solver, const Substep& substep, SolverScratch& scratch,
+                        const std::vector<Collider>& colliders, Workers& workers, PartClock& parts);
+
 // Removes the kind's damping fraction of the relative velocity along each constraint, by moving
 // x_prev, conserving momentum. One after another, in the seed's sweep's order (scratch.sweepOrder,
 // by particle pair) where the plan has one, else (lines) in the order the cloth keeps them.
