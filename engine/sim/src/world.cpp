@@ -640,9 +640,10 @@ void World::positionSubstep(Real h) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
     selfContact_->solve(records_, settings_.selfCollision, topologyVersion_, settings_.solver.substeps - substep_,
                         *workers_, &parts);
-    // Where the contacts pushed, the constraints answer: a sweep of each cloth they pushed, holding
-    // what they pushed (position::sweepAfterContacts), and then the contacts pushed again from
-    // there (SelfContact::pushAgain), so that the fail-safe starts from the layers apart.
+    // Where the contacts pushed, the constraints answer: a sweep of each cloth that pushed against
+    // itself, holding what it pushed (position::sweepAfterContacts; contacts between two cloths are
+    // not held, so a cloth only another pushed is left as it is), and then the contacts pushed
+    // again from there (SelfContact::pushAgain), so that the fail-safe starts from the layers apart.
     const bool pushed = std::any_of(records_.begin(), records_.end(),
                                     [](const ClothRecord& r) { return !r.work->solver.layerContacts.empty(); });
     if (pushed) {
