@@ -541,10 +541,6 @@ void sweepInBatches(Cloth& cloth, const Compliances& compliances, const StretchP
   }
 }
 
-}  // namespace
-
-namespace {
-
 // One sweep: every constraint (a line at a time with the lines, else in the seed's order), then
 // the self-contacts held (scratch.layerContacts) and the collider contacts' planes, with friction.
 void sweep(Cloth& cloth, bool lines, const Compliances& compliances, const StretchPlan& plan, const Substep& substep,

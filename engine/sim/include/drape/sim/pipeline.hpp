@@ -51,7 +51,7 @@ enum class Stage : std::uint8_t {
   broadPhase,    // the vertex-triangle and edge-edge pairs that may come within reach (a tree of boxes)
   narrowPhase,   // each pair's closest points, and whether it is near enough to push
   contactSweep,  // the pairs' constraints, swept
-  sweepAfter,    // one more sweep of each cloth the contacts pushed, those held, and the contacts pushed again
+  sweepAfter,    // one more sweep of each cloth that pushed against itself, those held; the contacts pushed again
   failSafe,      // no step makes two triangles pass through each other
 };
 
