@@ -63,7 +63,8 @@ struct Line {
 // from 1.032 to 1.066 (now 1.050 to 1.050). XPBD's compliance makes the system regular, but a
 // stiff fabric's only just (alpha~ about 6e-4 of the diagonal for cotton at 32 x 32): pulled at
 // 1 m/s, its rows were thrown from 0.16 to 3.5 times their length within 0.15 s (now 1.148 to
-// 1.152, the pull's 15 %). (With geometric stiffness the full step is the guard.)
+// 1.152, the pull's 15 %). With geometric stiffness (a stretch target) the full step is no guard: a
+// line with a held span takes this step instead (hasHeldSpan).
 //
 // Pushed shorter than its links instead (fingers closing on a cloth), a straight span is as
 // singular: the full step made every link but one exact and turned that one round (its particle
@@ -210,7 +211,8 @@ void settleHeldSpans(const DistanceConstraint* link, std::size_t links, const Pa
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
 //
 // settleSpans: take the steps of spans held at both ends only as far as they mend them
-// (settleHeldSpans: for the seed's model without geometric stiffness, and for XPBD).
+// (settleHeldSpans; every plain step does, whatever the model: a line with a held span never takes
+// the full step, hasHeldSpan).
 // With kAlongStart (XPBD) each link moves its particles along its direction at the substep's start
 // where it is slack enough (position::alongStart), which keeps the cloth's angular momentum:
 // dx_k = w_k (dlambda_{k-1} n0_{k-1} - dlambda_k n0_k), dlambda from the system above.
@@ -499,6 +501,32 @@ bool needsFullStep(const SolverScratch::LineFamily& lines, const DistanceConstra
   return false;
 }
 
+// Whether line l has a span held at both ends (a held particle, free ones, a held one: between two
+// fingers, or a pin and a finger). Such a span, straight, makes the full step's system singular
+// as it does the tridiagonal one's (every link pulling alike moves nothing), and the geometric
+// stiffness, which acts across the links only, does not make it regular: pushed shorter, the full
+// step made all its links but one exact and turned that one round; pulled past its length, the
+// tiny pivots threw it sideways. Four fingers pushing the desk's corners in and drawing them out
+// (the `spread` gesture) with a stretch target had links at 2.5 times their length the step the
+// fingers came down and diverged at 2.38 s (every setting of substeps and sweeps). Such a line
+// takes the tridiagonal step, whose held spans are mended (settleHeldSpans).
+bool hasHeldSpan(const SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, std::size_t l,
+                 const Real* w) {
+  const DistanceConstraint* link = stretch + lines.firstLink(l);
+  bool heldBefore = false, freeSince = false;
+  for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {
+    if (k == 0) heldBefore = w[link[0].a] == 0.0;
+    if (w[link[k].b] == 0.0) {
+      if (heldBefore && freeSince) return true;
+      heldBefore = true;
+      freeSince = false;
+    } else {
+      freeSince = true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 bool cpuHasAvx() {
@@ -750,7 +778,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
           [&](std::size_t first, std::size_t last, int) {
             for (std::size_t l = first; l < last; ++l) {
               lines.taut[l] =
-                  needsFullStep(lines, stretch, cloth.stretchTension.data(), l, s.mass.data(), scratch.fullStepRatio)
+                  needsFullStep(lines, stretch, cloth.stretchTension.data(), l, s.mass.data(), scratch.fullStepRatio) &&
+                          !hasHeldSpan(lines, stretch, l, s.inverseMass.data())
                       ? 1
                       : 0;
             }
@@ -828,8 +857,8 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
                               solveLines<G, true>(s, p, lambda, summed, restart, n, stiffness, alpha, true, normal,
                                                   upper, solution);
                             } else {
-                              solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha,
-                                                   !geometricStiffness, normal, upper, solution);
+                              solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha, true, normal,
+                                                   upper, solution);
                             }
                           });
             }
