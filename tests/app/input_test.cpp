@@ -231,6 +231,7 @@ TEST(Session, ASceneThatFailsToLoadLeavesTheCurrentOneRunning) {
 
 TEST(Session, UndoTakesBackACutAndADrawnCloth) {
   Session session("desk");
+  const std::size_t grid = session.world().cloths()[0].state.position.size();  // before any cut
   interact::Interaction& hand = session.interaction();
   hand.setMode(interact::Mode::cut);
   ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.5, 0.0, 0.0})));
@@ -249,7 +250,7 @@ TEST(Session, UndoTakesBackACutAndADrawnCloth) {
   EXPECT_EQ(session.world().cloths().size(), 1u);
   ASSERT_TRUE(session.undo());  // the cut
   EXPECT_EQ(session.world().cloths()[0].pieceCount, 1u);
-  EXPECT_EQ(session.world().cloths()[0].state.position.size(), 576u);
+  EXPECT_EQ(session.world().cloths()[0].state.position.size(), grid);
   EXPECT_FALSE(session.undo());
 }
 
@@ -264,6 +265,7 @@ double totalMass(const Session& session) {
 
 TEST(Session, UndoingACutKeepsTheMotionSinceAndTheMassAndTheCutShowsAsASeamForAMoment) {
   Session session("desk");
+  const std::size_t grid = session.world().cloths()[0].state.position.size();  // before any cut
   const double mass = totalMass(session);
   interact::Interaction& hand = session.interaction();
   hand.setMode(interact::Mode::cut);
@@ -273,7 +275,7 @@ TEST(Session, UndoingACutKeepsTheMotionSinceAndTheMassAndTheCutShowsAsASeamForAM
   ASSERT_TRUE(hand.up(1));
   ASSERT_EQ(session.seams().size(), 1u);
   EXPECT_EQ(session.seams()[0].path.size(), 2u);
-  ASSERT_GT(session.world().cloths()[0].state.position.size(), 576u);
+  ASSERT_GT(session.world().cloths()[0].state.position.size(), grid);
   // Drag the near half 20 cm along x.
   hand.setMode(interact::Mode::sticky);
   ASSERT_TRUE(hand.down(2, interact::Pointer::at({0.0, 0.0, 0.15})));
@@ -286,9 +288,9 @@ TEST(Session, UndoingACutKeepsTheMotionSinceAndTheMassAndTheCutShowsAsASeamForAM
   const std::vector<sim::Vec3> moved = session.world().cloths()[0].state.position;
   ASSERT_TRUE(session.undo());
   const sim::Cloth& cloth = session.world().cloths()[0];
-  ASSERT_EQ(cloth.state.position.size(), 576u);
+  ASSERT_EQ(cloth.state.position.size(), grid);
   EXPECT_EQ(cloth.pieceCount, 1u);
-  for (std::size_t i = 0; i < 576; ++i) ASSERT_EQ(cloth.state.position[i], moved[i]) << i;
+  for (std::size_t i = 0; i < grid; ++i) ASSERT_EQ(cloth.state.position[i], moved[i]) << i;
   EXPECT_GT(cloth.state.position[cloth.rest.index(12, 20)].x, -0.3 + 0.6 * 12.0 / 23.0 + 0.1);  // still dragged
   EXPECT_EQ(totalMass(session), mass);
   // The seam fades in a second and a half of the app's time.
@@ -300,6 +302,7 @@ TEST(Session, UndoingACutKeepsTheMotionSinceAndTheMassAndTheCutShowsAsASeamForAM
 
 TEST(Session, ATearRunningOverManyStepsIsUndoneAsOneWithTheMotionSince) {
   Session session("desk-tear");
+  const std::size_t grid = session.world().cloths()[0].state.position.size();  // before any cut
   const double mass = totalMass(session);
   interact::Interaction& hand = session.interaction();
   ASSERT_TRUE(hand.down(1, interact::Pointer::at({-0.2, 0.0, 0.0})));
@@ -317,16 +320,17 @@ TEST(Session, ATearRunningOverManyStepsIsUndoneAsOneWithTheMotionSince) {
   ASSERT_TRUE(session.undo());
   EXPECT_EQ(session.status, "took back the last tear");
   const sim::Cloth& cloth = session.world().cloths()[0];
-  ASSERT_EQ(cloth.state.position.size(), 576u);
+  ASSERT_EQ(cloth.state.position.size(), grid);
   EXPECT_EQ(cloth.topology.torn, 0u);
   EXPECT_EQ(cloth.pieceCount, 1u);
-  for (std::size_t i = 0; i < 576; ++i) ASSERT_EQ(cloth.state.position[i], now[i]) << i;
+  for (std::size_t i = 0; i < grid; ++i) ASSERT_EQ(cloth.state.position[i], now[i]) << i;
   EXPECT_EQ(totalMass(session), mass);
   EXPECT_FALSE(session.undo());  // the tear was one
 }
 
 TEST(Session, RedoPutsBackACutWithTheMotionSinceAndADrawnClothAsItWas) {
   Session session("desk");
+  const std::size_t grid = session.world().cloths()[0].state.position.size();  // before any cut
   const double mass = totalMass(session);
   interact::Interaction& hand = session.interaction();
   EXPECT_FALSE(session.redo());
@@ -336,7 +340,7 @@ TEST(Session, RedoPutsBackACutWithTheMotionSinceAndADrawnClothAsItWas) {
   ASSERT_TRUE(hand.up(1));
   for (int i = 0; i < 5; ++i) session.step();
   const std::size_t cutParticles = session.world().cloths()[0].state.position.size();
-  ASSERT_GT(cutParticles, 576u);
+  ASSERT_GT(cutParticles, grid);
   const std::vector<sim::Vec3> atUndo = session.world().cloths()[0].state.position;
   ASSERT_TRUE(session.undo());
   // Carry the whole cloth 10 cm along x, then redo: the cut comes back where the cloth is now.
@@ -350,15 +354,15 @@ TEST(Session, RedoPutsBackACutWithTheMotionSinceAndADrawnClothAsItWas) {
   ASSERT_EQ(cut.state.position.size(), cutParticles);
   EXPECT_EQ(cut.pieceCount, 2u);
   EXPECT_EQ(totalMass(session), mass);
-  for (std::size_t i = 0; i < 576; ++i) ASSERT_EQ(cut.state.position[i], before[i]);
+  for (std::size_t i = 0; i < grid; ++i) ASSERT_EQ(cut.state.position[i], before[i]);
   // Every particle the cut made (a copy, or one on an edge it crossed) came along the 10 cm with the
   // particles beside it, not left behind.
-  for (std::size_t j = 576; j < cutParticles; ++j) {
+  for (std::size_t j = grid; j < cutParticles; ++j) {
     EXPECT_LT(glm::length(cut.state.position[j] - (atUndo[j] + sim::Vec3{0.1, 0.0, 0.0})), 1e-9) << j;
   }
   EXPECT_FALSE(session.redo());
   ASSERT_TRUE(session.undo());  // the cut again
-  EXPECT_EQ(session.world().cloths()[0].state.position.size(), 576u);
+  EXPECT_EQ(session.world().cloths()[0].state.position.size(), grid);
   // A drawn cloth: taken back, put back, and taken back again.
   hand.setMode(interact::Mode::create);
   ASSERT_TRUE(hand.down(2, interact::Pointer::at({0.5, 0.0, 0.5})));

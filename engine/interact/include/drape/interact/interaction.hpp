@@ -57,7 +57,7 @@ struct InteractionSettings {
   Real pinchHeight = 0.2;    // m, how far a pinch lifts
   Real liftSpeed = 1.0;      // m/s, how fast a finger rises or sinks to a new height (pinch, lift)
   // Drawn cloths:
-  Real spacing = 0.04;          // m, between particles
+  Real spacing = 0.02;          // m, between particles (the desk cloth's, 32 x 32 over 60 cm: 1.9 cm)
   Real tableHeight = 0.0;       // m, the table's y (outlines are drawn on it)
   Real clothHeight = 0.01;      // m, above the table where a drawn cloth appears
   Real arealDensity = 0.2;      // kg/m^2
