@@ -2,7 +2,7 @@
 // full twist (narrow and wide), a fast corner drag, a pinch lifted and lowered, a long strip dropped on the table, ten
 // cloths dropped on each other. Each is played as drape-cli plays it, the intersecting triangle
 // pairs counted every 5 steps, and must keep 0 at each; and each must do what it says to the cloth.
-// Here at the desk's 24 x 24 (the strip and the ten cloths coarser still, so the sanitizer build
+// Here at the desk's 32 x 32 (the strip and the ten cloths coarser, so the sanitizer build
 // runs them in seconds); tools/self-contact-cases plays them at 48 x 48 and 96 x 96 and counts every
 // step (docs/self-contact-cases.md).
 #include <gtest/gtest.h>
@@ -157,7 +157,7 @@ TEST(HardCase, APinchLiftedAndLoweredOntoTheRestLiesOnItWithoutPassingThrough) {
 }
 
 TEST(HardCase, ALongStripDroppedOnTheTablePilesWithoutPassingThroughItself) {
-  // 2 m by 10 cm at 4 x 80 (2.5 cm, the desk's spacing at 24 x 24).
+  // 2 m by 10 cm at 4 x 80 (2.5 cm, the desk's spacing when it shipped at 24 x 24).
   Played played(Played::Files{}, kAssets / "cases" / "strip.json", {},
                 {"cloths.0.grid.columns=4", "cloths.0.grid.rows=80"});
   played.until(played.scene.duration);
