@@ -318,7 +318,7 @@ double largestDifference(const json& a, const json& b) {
 // touch coordinates: translate-screen's finger lands about 1e-8 m from drape-cli's, and the cloth,
 // sliding on the table with stick and slip, carries that to 5.5e-5 m in 2.5 s (drape-cli's own
 // result moves 4.6e-5 m when its screen points move by 3e-7 of themselves). So that one is held to
-// 1 mm, a twenty-fifth of the desk's spacing: a wrong path from screen to table ends centimetres off.
+// 1 mm, a nineteenth of the desk's spacing: a wrong path from screen to table ends centimetres off.
 // The gestures that cover every path an event takes (world and screen points, a down's radius, pin,
 // lift and unpin, pinch-lift, cut, draw, tearing): the self-contact-heavy rest (crumple, drape,
 // rotate, spread, translate) take the app 7 to 20 s each
