@@ -114,9 +114,9 @@ inline double estimatedParticles(const sim::WorldSettings& world) {
 // Self-contact's pairs a particle grow with the square of its distance against the spacing (the
 // neighbours within reach in a layer; more in a pile). Up to a fifth of the spacing (the desk at
 // 24 x 24: 0.19) a substep of self-contact counts kSelfContactSweeps; beyond, that times the square
-// of the ratio to a fifth (the desk at 32 x 32: 0.26, 1.7 times). (A 24 x 24 sheet torn to shreds in its first step
-// at 2 cm, 0.46 of its 4.3 cm spacing, listed 326 pairs a particle: 0.8 s in Release and 9 s under
-// the sanitizers for that one step; docs/fuzzing.md, Findings.)
+// of the ratio to a fifth (the desk at 32 x 32: 0.26, 1.7 times). (A 24 x 24 sheet torn to shreds
+// in its first step at 2 cm, 0.46 of its 4.3 cm spacing, listed 326 pairs a particle: 0.8 s in
+// Release and 9 s under the sanitizers for that one step; docs/fuzzing.md, Findings.)
 //
 // A pin placed far from where its lattice puts the particle drags the cloth that far in its first
 // step, shredding it on the way (a tear threshold near 1) and sweeping every piece's box across the

@@ -210,16 +210,15 @@ void settleHeldSpans(const DistanceConstraint* link, std::size_t links, const Pa
 // overlap the lines' chains of divisions (Thomas' recurrence is serial within a line).
 // Scratch arrays hold (n - 1) * G entries, link k of line g at k * G + g.
 //
-// settleSpans: take the steps of spans held at both ends only as far as they mend them
-// (settleHeldSpans; every plain step does, whatever the model: a line with a held span never takes
-// the full step, hasHeldSpan).
+// The steps of spans held at both ends are taken only as far as they mend them (settleHeldSpans),
+// whatever the model: a line with a held span never takes the full step (hasHeldSpan).
 // With kAlongStart (XPBD) each link moves its particles along its direction at the substep's start
 // where it is slack enough (position::alongStart), which keeps the cloth's angular momentum:
 // dx_k = w_k (dlambda_{k-1} n0_{k-1} - dlambda_k n0_k), dlambda from the system above.
 template <std::size_t G, bool kAlongStart>
 void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array<Real*, G>& lambda,
                 const std::array<float*, G>& summed, bool restart, std::size_t n, Real stiffness, Real alphaTilde,
-                bool settleSpans, Vec3* normal, Real* upper, Real* solution) {
+                Vec3* normal, Real* upper, Real* solution) {
   const std::size_t links = n - 1;
   Vec3* x = s.position.data();
   const Real* w = s.inverseMass.data();
@@ -234,7 +233,7 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
       const Vec3 d = x[c.b] - x[c.a];
       const Real length2 = glm::dot(d, d);
       const Real diagonal = w[c.a] + w[c.b] + alphaTilde;
-      if (settleSpans) held[g] += (k == 0 && w[c.a] == 0.0) + (w[c.b] == 0.0);
+      held[g] += (k == 0 && w[c.a] == 0.0) + (w[c.b] == 0.0);
       if (length2 > 1e-20 && diagonal > 0.0) {
         const Real length = std::sqrt(length2);
         normal[at] = d * (1.0 / length);
@@ -259,7 +258,7 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
       const Real diagonal = upper[at];
       Real pivot = diagonal - lower * previousUpper[g];
       // Only a span between two held particles, straight, makes the system singular, in its last
-      // row; that link is then corrected as if alone (and with settleSpans the span is mended).
+      // row; that link is then corrected as if alone (and the span is mended below).
       if (!(pivot > 1e-9 * diagonal)) pivot = diagonal;
       const Real inverse = 1.0 / pivot;
       const Real coupling = k + 1 < links ? -w[p[g].link[k].b] * glm::dot(normal[at], normal[at + G]) : 0.0;
@@ -273,7 +272,7 @@ void solveLines(ParticleState& s, const std::array<Line, G>& p, const std::array
   for (std::size_t k = links - 1; k-- > 0;) {
     for (std::size_t g = 0; g < G; ++g) solution[k * G + g] -= upper[k * G + g] * solution[(k + 1) * G + g];
   }
-  for (std::size_t g = 0; settleSpans && g < G; ++g) {
+  for (std::size_t g = 0; g < G; ++g) {
     if (held[g] >= 2) {
       settleHeldSpans(p[g].link, links, s, w, normal + g, solution + g, G, stiffness, alphaTilde, lambda[g]);
     }
@@ -509,14 +508,14 @@ bool needsFullStep(const SolverScratch::LineFamily& lines, const DistanceConstra
 // tiny pivots threw it sideways. Four fingers pushing the desk's corners in and drawing them out
 // (the `spread` gesture) with a stretch target had links at 2.5 times their length the step the
 // fingers came down and diverged at 2.38 s (at 2 x 8 and five other settings; 4 x 2 ended with
-// links 1,990 times their length). Such a line
-// takes the tridiagonal step, whose held spans are mended (settleHeldSpans).
+// links 1,990 times their length). Such a line takes the tridiagonal step, whose held spans are
+// mended (settleHeldSpans).
 bool hasHeldSpan(const SolverScratch::LineFamily& lines, const DistanceConstraint* stretch, std::size_t l,
                  const Real* w) {
   const DistanceConstraint* link = stretch + lines.firstLink(l);
-  bool heldBefore = false, freeSince = false;
-  for (std::size_t k = 0, links = lines.start[l + 1] - lines.start[l] - 1; k < links; ++k) {
-    if (k == 0) heldBefore = w[link[0].a] == 0.0;
+  const std::size_t links = lines.start[l + 1] - lines.start[l] - 1;
+  bool heldBefore = links > 0 && w[link[0].a] == 0.0, freeSince = false;
+  for (std::size_t k = 0; k < links; ++k) {
     if (w[link[k].b] == 0.0) {
       if (heldBefore && freeSince) return true;
       heldBefore = true;
@@ -844,24 +843,23 @@ void step(Cloth& cloth, SolverScratch& scratch, Real stiffness, bool xpbd, Real 
               }
             } else {
               // With geometric stiffness every solve adds its multipliers to the tension sums.
-              inGroups<4>(lines, stretch, line, last - first, xpbd,
-                          [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
-                                             const auto& firstLink, std::size_t n) {
-                            std::array<float*, G> summed{};
-                            for (std::size_t g = 0; geometricStiffness && scratch.sumTension && g < G; ++g) {
-                              summed[g] = cloth.stretchTension.data() + firstLink[g];
-                            }
-                            Vec3* normal = scratch.lineNormal.data() + slice;
-                            Real* upper = scratch.lineUpper.data() + slice;
-                            Real* solution = scratch.lineSolution.data() + slice;
-                            if (xpbd) {
-                              solveLines<G, true>(s, p, lambda, summed, restart, n, stiffness, alpha, true, normal,
-                                                  upper, solution);
-                            } else {
-                              solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha, true, normal,
-                                                   upper, solution);
-                            }
-                          });
+              inGroups<4>(
+                  lines, stretch, line, last - first, xpbd,
+                  [&]<std::size_t G>(std::integral_constant<std::size_t, G>, const auto& p, const auto& lambda,
+                                     const auto& firstLink, std::size_t n) {
+                    std::array<float*, G> summed{};
+                    for (std::size_t g = 0; geometricStiffness && scratch.sumTension && g < G; ++g) {
+                      summed[g] = cloth.stretchTension.data() + firstLink[g];
+                    }
+                    Vec3* normal = scratch.lineNormal.data() + slice;
+                    Real* upper = scratch.lineUpper.data() + slice;
+                    Real* solution = scratch.lineSolution.data() + slice;
+                    if (xpbd) {
+                      solveLines<G, true>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
+                    } else {
+                      solveLines<G, false>(s, p, lambda, summed, restart, n, stiffness, alpha, normal, upper, solution);
+                    }
+                  });
             }
           },
           grain);
