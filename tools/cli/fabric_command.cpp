@@ -74,7 +74,7 @@ std::vector<DrapeRun> drapeRuns() {
 // cantilever run's error against its spacing, one mark a stretch setting; right: each preset's
 // drape coefficient against the spacing at 10 x 4 with lines (drape-series.csv: a row a spacing, a
 // column a preset).
-std::string plotScript() {
+std::string fabricPlotScript() {
   std::ostringstream gp;
   gp << "set terminal pngcairo size 1200,440 font ',10'\n"
      << "if (!exists('outfile')) outfile = 'fabric.png'\nset output outfile\n"
@@ -405,7 +405,7 @@ int fabric(const FabricArguments& arguments) {
                                  {directory / "drape.csv", drapeCsv.str()},
                                  {directory / "drape-series.csv", series.str()},
                                  {directory / "spin.csv", spinCsv.str()},
-                                 {directory / "fabric.gp", plotScript()}});
+                                 {directory / "fabric.gp", fabricPlotScript()}});
     drawWithGnuplot(directory, "fabric.gp", "fabric.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {

@@ -43,7 +43,7 @@ BoundCells boundCells(std::optional<double> largest, bool hasBound, double theor
 }
 
 // Run in the output folder (drawWithGnuplot): names its files relative to it.
-std::string plotScript() {
+std::string stabilityPlotScript() {
   std::ostringstream gp;
   gp << "set terminal pngcairo size 1500,360 font ',10'\n"
      << "if (!exists('outfile')) outfile = 'stability.png'\nset output outfile\n"
@@ -178,7 +178,7 @@ int stability(const StabilityArguments& arguments) {
                                  {directory / "position.csv", positionMap.str()},
                                  {directory / "stability.csv", map.str()},
                                  {directory / "boundaries.csv", boundaries.str()},
-                                 {directory / "stability.gp", plotScript()}});
+                                 {directory / "stability.gp", stabilityPlotScript()}});
     drawWithGnuplot(directory, "stability.gp", "stability.png");
     if (arguments.report) scene::writeFileAtomically(*arguments.report, report.str());
     if (!arguments.quiet) {

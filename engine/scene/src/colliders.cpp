@@ -15,9 +15,6 @@ namespace drape::scene {
 
 namespace {
 
-constexpr double kMaxCoordinate = 1.0e4;  // m
-constexpr double kDegrees = 3.14159265358979323846 / 180.0;
-
 glm::dquat fromDegrees(sim::Vec3 degrees) { return glm::dquat(degrees * kDegrees); }  // Euler x, y, z
 
 std::shared_ptr<const sim::TriangleMesh> loadObj(ObjectReader& reader, const std::string& sceneSource, double scale) {

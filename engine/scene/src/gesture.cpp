@@ -18,8 +18,6 @@ using interact::Pointer;
 using nlohmann::json;
 
 constexpr std::size_t kMaxEvents = 1000000;
-constexpr double kMaxCoordinate = 1.0e4;  // m
-constexpr double kDegrees = 3.14159265358979323846 / 180.0;
 
 render::Camera readCamera(ObjectReader& reader, double& aspect) {
   render::Camera camera;

@@ -16,6 +16,10 @@
 
 namespace drape::scene {
 
+// Limits and units shared by the scene and gesture readers.
+inline constexpr double kMaxCoordinate = 1.0e4;                     // m
+inline constexpr double kDegrees = 3.14159265358979323846 / 180.0;  // radians a degree
+
 struct Range {
   double min;
   double max;

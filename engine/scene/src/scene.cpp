@@ -22,8 +22,6 @@ namespace drape::scene {
 
 namespace {
 
-constexpr double kDegrees = 3.14159265358979323846 / 180.0;  // radians a degree
-
 using nlohmann::json;
 using sim::ConstraintKind;
 using sim::KindMaterial;
@@ -32,7 +30,6 @@ using sim::Model;
 constexpr int kMaxCloths = 64;
 constexpr int kMaxColliders = 256;
 constexpr std::size_t kMaxPins = 100000;
-constexpr double kMaxCoordinate = 1.0e4;  // m
 
 // Defaults per model: the position model's 0..1 stiffnesses, and the force model's springs in N/m
 // and N s/m (sized for a ~1 kg sheet of a few hundred particles).

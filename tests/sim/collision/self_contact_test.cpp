@@ -23,7 +23,7 @@ namespace {
 
 constexpr Real kDistance = 0.005;
 
-ClothSettings flatSheet(int n, Real size, Vec3 origin) {
+ClothSettings flatSheetAt(int n, Real size, Vec3 origin) {
   ClothSettings cloth;
   cloth.lattice = {n, n, size, size, origin, LatticePlane::xz};
   cloth.mass = 0.1;
@@ -62,7 +62,7 @@ Real meanY(const Cloth& cloth) {
   return sum / static_cast<Real>(cloth.state.position.size());
 }
 
-Vec3 momentum(const World& world) {
+Vec3 totalMomentum(const World& world) {
   Vec3 p{0.0};
   for (std::size_t c = 0; c < world.cloths().size(); ++c) {
     const ParticleState& s = world.cloths()[c].state;
@@ -98,15 +98,15 @@ WorldSettings thrownOntoALyingCloth(int columns, Real height, Vec3 velocity) {
   settings.solver.substeps = 4;
   settings.solver.iterations = 8;
   settings.colliders.push_back(table());
-  ClothSettings thrown = flatSheet(10, 0.3, {-0.15, height, -0.15});
+  ClothSettings thrown = flatSheetAt(10, 0.3, {-0.15, height, -0.15});
   thrown.initialVelocity = velocity;
-  settings.cloths = {flatSheet(columns, 0.5, {-0.25, 0.005, -0.25}), thrown};
+  settings.cloths = {flatSheetAt(columns, 0.5, {-0.25, 0.005, -0.25}), thrown};
   return settings;
 }
 
 TEST(SelfContact, IsItsOwnStageWithNoTravelCap) {
   WorldSettings settings = withSelfContact({});
-  settings.cloths.push_back(flatSheet(8, 0.4, {0.0, 1.0, 0.0}));
+  settings.cloths.push_back(flatSheetAt(8, 0.4, {0.0, 1.0, 0.0}));
   const World world(settings);
   EXPECT_TRUE(world.hasStage(Stage::selfContact));
   EXPECT_FALSE(world.hasStage(Stage::selfCollide));
@@ -123,7 +123,7 @@ TEST(SelfContact, AFreeFallFallsAsWithoutIt) {
   WorldSettings settings;
   settings.solver.substeps = 4;
   settings.solver.iterations = 8;
-  settings.cloths.push_back(flatSheet(16, 0.3, {-0.15, 10.0, -0.15}));
+  settings.cloths.push_back(flatSheetAt(16, 0.3, {-0.15, 10.0, -0.15}));
   World without(settings);
   World with(withSelfContact(settings));
   ASSERT_EQ(without.run(60), StepStatus::ok);
@@ -147,8 +147,8 @@ TEST(SelfContact, TwoClothsThrownAtEachOtherKeepTheirMomentumAndStayApart) {
   settings.gravity = Vec3{0.0};
   settings.solver.substeps = 4;
   settings.solver.iterations = 8;
-  ClothSettings below = flatSheet(12, 0.3, {-0.15, 0.0, -0.15});
-  ClothSettings above = flatSheet(12, 0.3, {-0.13, 0.04, -0.14});  // a little off, so edges cross edges
+  ClothSettings below = flatSheetAt(12, 0.3, {-0.15, 0.0, -0.15});
+  ClothSettings above = flatSheetAt(12, 0.3, {-0.13, 0.04, -0.14});  // a little off, so edges cross edges
   below.initialVelocity = Vec3{0.0, 1.0, 0.0};
   above.initialVelocity = Vec3{0.05, -1.0, 0.0};
   settings.cloths = {below, above};
@@ -172,8 +172,8 @@ TEST(SelfContact, TwoClothsThrownAtEachOtherKeepTheirMomentumAndStayApart) {
   // 1.2e-10 off the analytic momentum (the start's rounding: x_prev = x - v h); with it, no farther.
   World through(settings);
   ASSERT_EQ(through.run(30), StepStatus::ok);
-  EXPECT_LT(glm::length(momentum(world) - momentum(through)), 1e-13);
-  EXPECT_LT(glm::length(momentum(world) - before), 1e-9);
+  EXPECT_LT(glm::length(totalMomentum(world) - totalMomentum(through)), 1e-13);
+  EXPECT_LT(glm::length(totalMomentum(world) - before), 1e-9);
   EXPECT_GT(meanY(world.cloths()[1]), meanY(world.cloths()[0]) + 0.5 * kDistance);  // still on top
 }
 
@@ -193,11 +193,11 @@ Real slideOnClothSlope(Real theta, Real mu, Real seconds) {
   settings.solver.iterations = 8;
   settings.gravity = 9.81 * Vec3{std::sin(theta), -std::cos(theta), 0.0};
   settings.air.drag = 0.0;
-  ClothSettings below = flatSheet(12, 0.55, {-0.275, 0.0, -0.275});
+  ClothSettings below = flatSheetAt(12, 0.55, {-0.275, 0.0, -0.275});
   for (int row = 0; row < 12; ++row) {
     for (int column = 0; column < 12; ++column) below.pins.push_back({column, row, std::nullopt});
   }
-  ClothSettings above = flatSheet(3, 0.1, {-0.25, kDistance, -0.05});
+  ClothSettings above = flatSheetAt(3, 0.1, {-0.25, kDistance, -0.05});
   above.material(ConstraintKind::bend) = {1.0, 0.0};
   settings.cloths = {below, above};
   settings = withSelfContact(settings);
@@ -243,7 +243,7 @@ TEST(SelfContact, AFingerDraggedAcrossTheClothAt5MetresASecondNeverPullsItThroug
   settings.solver.iterations = 8;
   settings.air.drag = 0.5;
   settings.colliders.push_back(table());
-  settings.cloths.push_back(flatSheet(16, 0.6, {-0.3, 0.005, -0.3}));
+  settings.cloths.push_back(flatSheetAt(16, 0.6, {-0.3, 0.005, -0.3}));
   World world(withSelfContact(settings));
   ASSERT_GT(world.pressFinger(1, {-0.3, 0.005, -0.3}, 0.05), 0);
   std::size_t worst = 0;
@@ -287,7 +287,7 @@ TEST(SelfContact, AFoldThrownThroughItselfAtItsCreaseStaysOnItsSide) {
     settings.solver.substeps = 1;
     settings.solver.iterations = 4;
     settings.gravity = Vec3{0.0};
-    ClothSettings cloth = flatSheet(2, 0.1, {0.0, 0.5, 0.0});
+    ClothSettings cloth = flatSheetAt(2, 0.1, {0.0, 0.5, 0.0});
     cloth.material(ConstraintKind::shear).stiffness = 0.0;  // no link across the fold
     cloth.material(ConstraintKind::bend).stiffness = 0.0;
     settings.cloths.push_back(cloth);
@@ -344,7 +344,7 @@ TEST(SelfContact, AFoldThrownThroughItselfAtItsCreaseStaysOnItsSide) {
 // which costs that leaf a comparison with the others, no more.
 TEST(SelfContact, AParticleFlungFarAwayCostsTheBroadPhaseNoMoreThanTheCloth) {
   WorldSettings settings = withSelfContact({});
-  settings.cloths.push_back(flatSheet(8, 0.4, {-0.2, 0.3, -0.2}));
+  settings.cloths.push_back(flatSheetAt(8, 0.4, {-0.2, 0.3, -0.2}));
   World world(settings);
   std::vector<Cloth> cloths = world.cloths().copy();
   cloths[0].state.position[27].y = 1.9e13;
@@ -375,8 +375,8 @@ TEST(SelfContact, ThreadsGiveTheSameResultBitForBit) {
 // substep's start or end, are listed, each once; and 1 and 2 threads list them in the same order.
 TEST(SelfContact, TheBroadPhaseListsEveryPairWithinTheDistanceOnce) {
   WorldSettings settings = withSelfContact({});
-  settings.cloths.push_back(flatSheet(9, 0.2, {-0.1, 0.0, -0.1}));
-  settings.cloths.push_back(flatSheet(7, 0.15, {-0.08, 0.01, -0.06}));
+  settings.cloths.push_back(flatSheetAt(9, 0.2, {-0.1, 0.0, -0.1}));
+  settings.cloths.push_back(flatSheetAt(7, 0.15, {-0.08, 0.01, -0.06}));
   std::vector<Cloth> cloths = World(settings).cloths().copy();
   std::mt19937 random(7);
   std::uniform_real_distribution<Real> off(-0.03, 0.03), motion(-0.01, 0.01);
@@ -507,8 +507,8 @@ Real segmentsApart(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b
 // exactly. (Where the proof forgot the corners' motion, a pair 4.9 mm apart was called far.)
 TEST(SelfContact, APairCalledFarIsFartherThanTheDistanceThroughTheSubstep) {
   WorldSettings settings = withSelfContact({});
-  settings.cloths.push_back(flatSheet(9, 0.2, {-0.1, 0.0, -0.1}));
-  settings.cloths.push_back(flatSheet(7, 0.15, {-0.07, 0.008, -0.07}));
+  settings.cloths.push_back(flatSheetAt(9, 0.2, {-0.1, 0.0, -0.1}));
+  settings.cloths.push_back(flatSheetAt(7, 0.15, {-0.07, 0.008, -0.07}));
   std::vector<ClothRecord> records = recordsOf(World(settings).cloths().copy());
   Workers workers(2);
   contact::SelfContact contact;
@@ -560,8 +560,8 @@ TEST(SelfContact, APairCalledFarIsFartherThanTheDistanceThroughTheSubstep) {
 // (within two distances: their boxes overlap its triangles').
 TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
   WorldSettings settings = withSelfContact({});
-  settings.cloths.push_back(flatSheet(9, 0.2, {-0.1, 0.0, -0.1}));
-  settings.cloths.push_back(flatSheet(7, 0.15, {-0.07, 0.03, -0.07}));
+  settings.cloths.push_back(flatSheetAt(9, 0.2, {-0.1, 0.0, -0.1}));
+  settings.cloths.push_back(flatSheetAt(7, 0.15, {-0.07, 0.03, -0.07}));
   const std::vector<Cloth> cloths = World(settings).cloths().copy();
   using Listed = std::set<std::tuple<bool, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>>;
   const auto listed = [](const contact::SelfContact& contact) {
@@ -610,7 +610,7 @@ TEST(SelfContact, PairsFoundAgainInTheFailSafeAreThoseASearchFinds) {
 // pairs are listed; lifted 100 m, none are.
 TEST(SelfContact, ATriangleStretchedTenfoldButShorterThanItsClothStillTakesPart) {
   WorldSettings settings = withSelfContact({});
-  settings.cloths.push_back(flatSheet(21, 0.2, {-0.1, 0.0, -0.1}));
+  settings.cloths.push_back(flatSheetAt(21, 0.2, {-0.1, 0.0, -0.1}));
   const std::vector<Cloth> cloths = World(settings).cloths().copy();
   const auto pairsWithCorner = [&](Real lift) {
     std::vector<ClothRecord> copy = recordsOf(cloths);

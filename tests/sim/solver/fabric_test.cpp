@@ -26,7 +26,7 @@ double bendingEnergy(const ClothRest& rest, const std::vector<Vec3>& x, double r
   return energy;
 }
 
-ClothRest flatSheet(int n) {
+ClothRest flatRest(int n) {
   LatticeSpec spec;
   spec.columns = spec.rows = n;
   ClothRest rest = buildLattice(spec);
@@ -47,7 +47,7 @@ std::vector<Vec3> rolled(const ClothRest& rest, double r, double degrees) {
 }
 
 TEST(BendStencils, EveryParticleButTheCornersHasOneAndAFlatSheetStoresNoEnergy) {
-  const ClothRest rest = flatSheet(9);
+  const ClothRest rest = flatRest(9);
   // Every particle but the four corners (on no line: their two links are at right angles).
   ASSERT_EQ(rest.bending.size(), 81u - 4u);
   int sizes[kBendStencilSize + 1] = {};
@@ -68,7 +68,7 @@ TEST(BendStencils, ARolledSheetStoresThePlatesEnergyWhicheverWayItIsRolled) {
   // A plate of rigidity B curved to radius R stores B / (2 R^2) per square metre. The border's
   // stencils see only the border's own line, so the two borders the roll bends across lose their
   // half cells: on a 1 m sheet of 41 columns 39/40 of it is kept.
-  const ClothRest rest = flatSheet(41);
+  const ClothRest rest = flatRest(41);
   const double B = 2.0e-5, R = 0.5, plate = B / (2.0 * R * R);
   for (double degrees : {0.0, 90.0}) {
     EXPECT_NEAR(bendingEnergy(rest, rolled(rest, R, degrees), B) / plate, 39.0 / 40.0, 2e-3) << degrees;
@@ -287,7 +287,7 @@ double residual(const ClothRest& rest, const ParticleState& s, const std::vector
 }
 
 TEST(BendingBlock, OneProjectionMeetsEveryStencilsEquationAndLeavesPinsWhereTheyAre) {
-  const ClothRest rest = flatSheet(13);
+  const ClothRest rest = flatRest(13);
   ParticleState s = bentState(rest);
   const ParticleState before = s;
   const double alphaTilde = 1.0 / (6.4e-5 * 1e-6);  // denim at h = 1 ms
@@ -313,7 +313,7 @@ TEST(BendingBlock, OneProjectionMeetsEveryStencilsEquationAndLeavesPinsWhereThey
 }
 
 TEST(BendingBlock, IsFactoredAgainWhenAParticleIsPinnedAndRefusedWhenTooWide) {
-  const ClothRest rest = flatSheet(13);
+  const ClothRest rest = flatRest(13);
   ParticleState s = bentState(rest);
   const double alphaTilde = 2.0e3;
   BendingFactor factor;
@@ -329,7 +329,7 @@ TEST(BendingBlock, IsFactoredAgainWhenAParticleIsPinnedAndRefusedWhenTooWide) {
   EXPECT_EQ(s.position[held], where);
   EXPECT_LT(residual(rest, s, lambda, alphaTilde), 1e-9 * start);
   // A 101 x 101 sheet: 10,197 stencils of half-bandwidth about 200, 4e8 to factor, over the limit.
-  const ClothRest wide = flatSheet(101);
+  const ClothRest wide = flatRest(101);
   const ParticleState far = bentState(wide);
   BendingFactor wideFactor;
   EXPECT_FALSE(bending::prepare(wideFactor, wide.bending, far.inverseMass, alphaTilde));
