@@ -82,8 +82,9 @@ TEST(ShippedScenes, SlopeHoldsItsClothBelowTheFrictionAngleAndNotAbove) {
   EXPECT_GT(creep({"colliders.0.friction={\"static\":0.2,\"kinetic\":0.2}"}), 0.3);  // mu = 0.2: it slides
 }
 
-// The fold scene holds a cloth along row 16; rows 0-13 are the half that topples over, 18-31 the
-// half that hangs. Returns the closest distance between the two halves and the upper half's top.
+// The fold scene holds a cloth along its middle row (24 of 48); the rows above it but the two
+// nearest are the half that topples over, those below it but the nearest the half that hangs.
+// Returns the closest distance between the two halves and the upper half's top.
 struct Fold {
   double closest;
   double upperTop;
@@ -92,11 +93,12 @@ struct Fold {
 Fold measureFold(const sim::World& world) {
   const sim::Cloth& cloth = world.cloths()[0];
   Fold fold{1.0, -1.0};
-  for (int r = 0; r <= 13; ++r) {
+  const int held = cloth.rest.rows / 2;
+  for (int r = 0; r <= held - 3; ++r) {
     for (int c = 0; c < cloth.rest.columns; ++c) {
       const sim::Vec3 a = cloth.state.position[cloth.rest.index(c, r)];
       fold.upperTop = std::max(fold.upperTop, a.y);
-      for (int r2 = 18; r2 < cloth.rest.rows; ++r2) {
+      for (int r2 = held + 2; r2 < cloth.rest.rows; ++r2) {
         for (int c2 = 0; c2 < cloth.rest.columns; ++c2) {
           fold.closest = std::min(fold.closest, glm::length(a - cloth.state.position[cloth.rest.index(c2, r2)]));
         }
@@ -109,7 +111,9 @@ Fold measureFold(const sim::World& world) {
 TEST(ShippedScenes, FoldSettlesInTwoLayersThatDoNotPassThroughEachOther) {
   const sim::World world = settle("fold");
   const double distance = world.settings().selfCollision.distance;
-  const double heldAt = world.cloths()[0].state.position[world.cloths()[0].rest.index(0, 16)].y;
+  const sim::Cloth& cloth = world.cloths()[0];
+  ASSERT_EQ(cloth.rest.rows % 2, 0);
+  const double heldAt = cloth.state.position[cloth.rest.index(0, cloth.rest.rows / 2)].y;
   const Fold folded = measureFold(world);
   EXPECT_LT(folded.upperTop, heldAt);         // the upper half has toppled over the held line
   EXPECT_GT(folded.closest, 0.5 * distance);  // and lies against the lower half, not in it
