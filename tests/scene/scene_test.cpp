@@ -117,7 +117,7 @@ TEST(ShippedScenes, FoldSettlesInTwoLayersThatDoNotPassThroughEachOther) {
   const Fold folded = measureFold(world);
   EXPECT_LT(folded.upperTop, heldAt);         // the upper half has toppled over the held line
   EXPECT_GT(folded.closest, 0.5 * distance);  // and lies against the lower half, not in it
-  EXPECT_LT(folded.closest, 0.15);            // side by side: the fold loop keeps them ~9 cm apart
+  EXPECT_LT(folded.closest, 0.15);            // side by side: the fold loop keeps them 2.8 cm apart
 }
 
 TEST(ShippedScenes, ARisingBallLiftsTheCloth) {
