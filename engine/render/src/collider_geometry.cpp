@@ -1,7 +1,9 @@
 #include "collider_geometry.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -68,6 +70,48 @@ void quad(const Frame& frame, sim::Vec3 centre, sim::Vec3 normal, sim::Vec3 u, s
   out.indices.insert(out.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
 }
 
+// A box of half extents h with its edges and corners rounded to radius r (0 < r <= min h): each
+// face of the box h is a grid, flat where the inner box h - r is and, towards its sides, at the
+// angles k / kRound of 45 degrees round the edge; each grid point p is carried to the inner box's
+// nearest point plus r along the way from it to p, and faces that way.
+void roundedBox(const Frame& frame, sim::Vec3 h, double r, ColliderGeometry& out) {
+  constexpr int kRound = 4;
+  const sim::Vec3 inner = h - sim::Vec3{r};
+  std::array<std::vector<double>, 3> at;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double>& t = at[static_cast<std::size_t>(axis)];
+    for (int k = kRound; k >= 1; --k) t.push_back(-inner[axis] - r * std::tan(0.25 * kPi * k / kRound));
+    t.push_back(-inner[axis]);
+    if (inner[axis] > 0.0) t.push_back(inner[axis]);
+    for (int k = 1; k <= kRound; ++k) t.push_back(inner[axis] + r * std::tan(0.25 * kPi * k / kRound));
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    const std::vector<double>&ta = at[static_cast<std::size_t>(a)], &tb = at[static_cast<std::size_t>(b)];
+    for (double side : {-1.0, 1.0}) {
+      const auto base = static_cast<std::uint32_t>(out.positions.size());
+      for (const double vb : tb) {
+        for (const double va : ta) {
+          sim::Vec3 p{0.0};
+          p[axis] = side * h[axis];
+          p[a] = va;
+          p[b] = vb;
+          const sim::Vec3 nearest = glm::clamp(p, -inner, inner);
+          const sim::Vec3 n = glm::normalize(p - nearest);
+          addVertex(out, frame.point(nearest + n * r), frame.direction(n));
+        }
+      }
+      const auto columns = static_cast<std::uint32_t>(ta.size());
+      for (std::uint32_t j = 0; j + 1 < tb.size(); ++j) {
+        for (std::uint32_t i = 0; i + 1 < columns; ++i) {
+          const std::uint32_t c = base + j * columns + i;
+          out.indices.insert(out.indices.end(), {c, c + 1, c + columns + 1, c, c + columns + 1, c + columns});
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool showsAsTable(const sim::Collider& collider) {
@@ -102,6 +146,13 @@ void appendColliderGeometry(const sim::Collider& collider, ColliderGeometry& out
     }
     case sim::ColliderShape::box: {
       const sim::Vec3 h = glm::max(s.halfExtents - sim::Vec3{inset}, 0.5 * s.halfExtents);
+      // Drawn `inset` inside: a rounded box's surface moved in by the inset is the box's half
+      // extents and its radius each less the inset (sharp where the radius is less than it).
+      const double r = std::min({std::max(s.rounding - inset, 0.0), h.x, h.y, h.z});
+      if (r > 0.0) {
+        roundedBox(frame, h, r, out);
+        return;
+      }
       for (int axis = 0; axis < 3; ++axis) {
         for (double side : {-1.0, 1.0}) {
           sim::Vec3 n{0.0}, u{0.0}, v{0.0};

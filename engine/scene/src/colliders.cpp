@@ -1,5 +1,6 @@
 #include "colliders.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -106,6 +107,10 @@ sim::ColliderSettings readCollider(ObjectReader& reader, const std::string& scen
     c.halfExtents = reader.vec3("halfExtents", sim::Vec3{0.5}, 1000.0, "m");
     if (!glm::all(glm::greaterThan(c.halfExtents, sim::Vec3{0.0}))) {
       reader.fail("halfExtents", "three positive numbers (m)", reader.raw("halfExtents"));
+    }
+    c.rounding = reader.number("rounding", 0.0, {0.0, 1000.0, false, "m"});
+    if (c.rounding > std::min({c.halfExtents.x, c.halfExtents.y, c.halfExtents.z})) {
+      reader.fail("rounding", "at most the smallest half extent (m)", reader.raw("rounding"));
     }
     c.orientation = fromDegrees(reader.vec3("rotation", sim::Vec3{0.0}, 3600.0, "degrees about x, y, z"));
   } else {

@@ -153,6 +153,9 @@ void validate(const WorldSettings& s) {
       case ColliderShape::box:
         require(finite(c.halfExtents) && glm::all(glm::greaterThan(c.halfExtents, Vec3{0.0})),
                 "box half extents must be positive");
+        require(std::isfinite(c.rounding) && c.rounding >= 0.0 &&
+                    c.rounding <= std::min({c.halfExtents.x, c.halfExtents.y, c.halfExtents.z}),
+                "box rounding must be in 0 .. its smallest half extent");
         break;
       case ColliderShape::mesh: require(c.mesh && !c.mesh->triangles.empty(), "mesh collider has no triangles"); break;
     }

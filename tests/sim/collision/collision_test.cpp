@@ -85,6 +85,46 @@ TEST(Colliders, SignedDistancesOfTheShapes) {
   EXPECT_NEAR(glm::length(ground.distance({5, 0.5, 5}, 10).normal - Vec3{0, 1, 0}), 0.0, 1e-12);
 }
 
+// A box rounded to radius r is the box shrunk by r and grown by r again: beside a face it is where
+// the sharp box is, beside an edge its surface is the quarter cylinder round the inner box's edge,
+// beside a corner the eighth of a sphere round its corner; inside, the nearest face is r nearer.
+// Rounded by 0 it is the sharp box, figure for figure.
+TEST(Colliders, ARoundedBoxIsItsInnerBoxGrownByTheRadius) {
+  const Vec3 h{1, 2, 3};
+  const double r = 0.25;
+  ColliderSettings s = box({0, 0, 0}, h);
+  s.rounding = r;
+  const Collider rounded(s), sharp(box({0, 0, 0}, h));
+  const auto expectNormal = [](const SurfaceDistance& d, Vec3 n) {
+    EXPECT_NEAR(glm::length(d.normal - glm::normalize(n)), 0.0, 1e-12);
+  };
+  // Beside a face, away from its edges: as the sharp box.
+  EXPECT_NEAR(rounded.distance({1.5, 0.3, -0.4}, 10).distance, 0.5, 1e-12);
+  expectNormal(rounded.distance({1.5, 0.3, -0.4}, 10), {1, 0, 0});
+  // Beside the edge x = 1, y = 2: from the axis of its cylinder (0.75, 1.75, z), less r.
+  const Vec3 nearEdge{1.2, 2.1, 0.5};
+  const Vec3 fromAxis = nearEdge - Vec3{0.75, 1.75, 0.5};
+  EXPECT_NEAR(rounded.distance(nearEdge, 10).distance, glm::length(fromAxis) - r, 1e-12);
+  expectNormal(rounded.distance(nearEdge, 10), fromAxis);
+  // Where the sharp edge was, the rounded surface is (sqrt 2 - 1) r away.
+  EXPECT_NEAR(rounded.distance({1, 2, 0}, 10).distance, (std::sqrt(2.0) - 1.0) * r, 1e-12);
+  // Beside the corner (1, 2, 3): from the centre of its sphere, less r.
+  const Vec3 nearCorner{1.3, 2.2, 3.4};
+  const Vec3 fromCentre = nearCorner - (h - Vec3{r});
+  EXPECT_NEAR(rounded.distance(nearCorner, 10).distance, glm::length(fromCentre) - r, 1e-12);
+  expectNormal(rounded.distance(nearCorner, 10), fromCentre);
+  // Inside, the nearest face.
+  EXPECT_NEAR(rounded.distance({0, 1.5, 0}, 10).distance, -0.5, 1e-12);
+  expectNormal(rounded.distance({0, 1.5, 0}, 10), {0, 1, 0});
+  // Rounded by 0: the sharp box's figures exactly.
+  s.rounding = 0.0;
+  const Collider none(s);
+  for (const Vec3 p : {Vec3{1.5, 0.3, -0.4}, nearEdge, nearCorner, Vec3{0, 1.5, 0}, Vec3{1, 2, 3}}) {
+    EXPECT_EQ(none.distance(p, 10).distance, sharp.distance(p, 10).distance);
+    EXPECT_EQ(none.distance(p, 10).normal, sharp.distance(p, 10).normal);
+  }
+}
+
 TEST(Colliders, AMovingColliderIsWhereItsMotionPutsIt) {
   ColliderSettings s = sphere({0, 0, 0}, 0.5);
   s.velocity = {0, 1, 0};

@@ -85,17 +85,19 @@ SurfaceDistance Collider::local(Vec3 p, Real reach) const {
       return {glm::length(away) - s.radius, unitOr(away, Vec3{0.0, 1.0, 0.0})};
     }
     case ColliderShape::box: {
-      const Vec3 q = glm::abs(p) - s.halfExtents;
+      // Rounded, it is the box shrunk by the radius and grown by it again: a distance and normal
+      // from the inner box, less the radius. (Sharp: the radius is 0, and each figure is as it was.)
+      const Vec3 q = glm::abs(p) - (s.halfExtents - s.rounding);
       const Vec3 outside = glm::max(q, Vec3{0.0});
       const Real outsideLength = glm::length(outside);
-      if (outsideLength > 0.0) return {outsideLength, glm::sign(p) * outside / outsideLength};
+      if (outsideLength > 0.0) return {outsideLength - s.rounding, glm::sign(p) * outside / outsideLength};
       // Inside: the nearest face is along the axis with the largest (least negative) q.
       int axis = 0;
       if (q.y > q[axis]) axis = 1;
       if (q.z > q[axis]) axis = 2;
       Vec3 normal{0.0};
       normal[axis] = p[axis] >= 0.0 ? 1.0 : -1.0;
-      return {q[axis], normal};
+      return {q[axis] - s.rounding, normal};
     }
     case ColliderShape::mesh: {
       SurfaceDistance best{reach, Vec3{0.0, 1.0, 0.0}};

@@ -40,6 +40,12 @@ struct ColliderSettings {
   Real radius = 0.5;                           // m, sphere and capsule
   Vec3 halfAxis{0.5, 0.0, 0.0};                // m, capsule: its segment runs from -halfAxis to +halfAxis
   Vec3 halfExtents{0.5};                       // m, box
+  // m, box: the radius its edges and corners are rounded to (0: sharp), at most its smallest half
+  // extent. A cloth refined far past the radius wraps a rounded edge; over a sharp one the link
+  // between the particle on top and the one on the side cuts through the corner, and its pull
+  // presses the particle on top into the face, which friction then holds however hard the link
+  // pulls (docs/design.md).
+  Real rounding = 0.0;
   std::shared_ptr<const TriangleMesh> mesh;
   Friction friction;
   Vec3 velocity{0.0};         // m/s, kinematic motion of the position
