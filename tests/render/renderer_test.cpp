@@ -98,11 +98,17 @@ Camera fromAbove(double height) {
 }
 
 // A rounded box is drawn on its own surface, or the inset inside it: every point of the drawing at
-// the collider's signed distance -inset, facing the way the surface there does. (Turned, moved and
-// rounded by a radius more and less than the inset.)
+// the collider's signed distance -inset, facing the way the surface there does, and its triangles
+// (each corner one of its points) covering the surface's area, that of the inner box (the half
+// extents less the radius, all less the inset) grown by the radius: its faces, a quarter cylinder
+// along each edge and an eighth of a sphere at each corner, less what the chords of 11.25 degrees
+// cut off (0.6 % where the radius is the smallest half extent; a face missing would take 10 %). Turned, moved, and rounded by a radius more and less than the inset, by the smallest half
+// extent (the inner box flat), and by 1e-17 m (drawn sharp).
 TEST(ColliderGeometry, ARoundedBoxIsDrawnOnItsSurface) {
-  for (const double rounding : {0.0, 0.001, 0.05}) {
+  const double pi = 3.141592653589793;
+  for (const double rounding : {0.0, 1e-17, 0.001, 0.05, 0.35}) {
     for (const double inset : {0.0, 0.002}) {
+      SCOPED_TRACE(::testing::Message() << "rounding " << rounding << ", inset " << inset);
       sim::ColliderSettings s;
       s.shape = sim::ColliderShape::box;
       s.position = {0.3, 0.4, -0.2};
@@ -113,19 +119,34 @@ TEST(ColliderGeometry, ARoundedBoxIsDrawnOnItsSurface) {
       ColliderGeometry geometry;
       appendColliderGeometry(box, geometry, inset);
       ASSERT_FALSE(geometry.indices.empty());
+      ASSERT_EQ(geometry.indices.size() % 3, 0u);
       double farthest = 0.0, turned = 0.0;
       for (std::size_t i = 0; i < geometry.positions.size(); ++i) {
         const sim::SurfaceDistance d = box.distance(sim::Vec3(geometry.positions[i]), 1.0);
+        ASSERT_TRUE(std::isfinite(d.distance)) << i;
         farthest = std::max(farthest, std::abs(d.distance + inset));
         turned = std::max(turned, glm::length(sim::Vec3(geometry.normals[i]) - d.normal));
       }
-      EXPECT_LT(farthest, 1e-6) << rounding << " " << inset;
+      EXPECT_LT(farthest, 1e-6);
       // (A sharp box's edge points face one of their faces; the distance's normal there is the
       // other's or either: only the rounded ones are checked for it. The drawing's points are
       // floats, some 3e-8 m off, which turns the normal of a 1 mm round by some 3e-5.)
-      if (rounding > inset) {
-        EXPECT_LT(turned, 1e-4) << rounding << " " << inset;
+      if (rounding > inset + 1e-9) {
+        EXPECT_LT(turned, 1e-4);
       }
+      double area = 0.0;
+      for (std::size_t k = 0; k < geometry.indices.size(); k += 3) {
+        for (int j = 0; j < 3; ++j) ASSERT_LT(geometry.indices[k + j], geometry.positions.size());
+        const sim::Vec3 a(geometry.positions[geometry.indices[k]]), b(geometry.positions[geometry.indices[k + 1]]),
+            c(geometry.positions[geometry.indices[k + 2]]);
+        area += 0.5 * glm::length(glm::cross(b - a, c - a));
+      }
+      const double r = std::max(rounding - inset, 0.0);
+      const sim::Vec3 inner = s.halfExtents - sim::Vec3{inset} - sim::Vec3{r};
+      const double expected = 8.0 * (inner.x * inner.y + inner.y * inner.z + inner.z * inner.x) +
+                              4.0 * pi * r * (inner.x + inner.y + inner.z) + 4.0 * pi * r * r;
+      EXPECT_LT(area, expected * (1.0 + 1e-6));
+      EXPECT_GT(area, expected * (1.0 - 1e-2));
     }
   }
 }

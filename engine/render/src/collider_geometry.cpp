@@ -80,10 +80,15 @@ void roundedBox(const Frame& frame, sim::Vec3 h, double r, ColliderGeometry& out
   std::array<std::vector<double>, 3> at;
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<double>& t = at[static_cast<std::size_t>(axis)];
-    for (int k = kRound; k >= 1; --k) t.push_back(-inner[axis] - r * std::tan(0.25 * kPi * k / kRound));
+    // (The last at the face's side itself, h: tan(45 degrees) is a rounding short of 1, and the
+    // faces meeting there would miss each other by it.)
+    const auto round = [&](int k) {
+      return k == kRound ? h[axis] : inner[axis] + r * std::tan(0.25 * kPi * k / kRound);
+    };
+    for (int k = kRound; k >= 1; --k) t.push_back(-round(k));
     t.push_back(-inner[axis]);
     if (inner[axis] > 0.0) t.push_back(inner[axis]);
-    for (int k = 1; k <= kRound; ++k) t.push_back(inner[axis] + r * std::tan(0.25 * kPi * k / kRound));
+    for (int k = 1; k <= kRound; ++k) t.push_back(round(k));
   }
   for (int axis = 0; axis < 3; ++axis) {
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
@@ -97,7 +102,10 @@ void roundedBox(const Frame& frame, sim::Vec3 h, double r, ColliderGeometry& out
           p[a] = va;
           p[b] = vb;
           const sim::Vec3 nearest = glm::clamp(p, -inner, inner);
-          const sim::Vec3 n = glm::normalize(p - nearest);
+          // Out of the face by r exactly (h - (h - r) may round to 0 for a radius far under h).
+          sim::Vec3 away = p - nearest;
+          away[axis] = side * r;
+          const sim::Vec3 n = glm::normalize(away);
           addVertex(out, frame.point(nearest + n * r), frame.direction(n));
         }
       }
@@ -149,7 +157,8 @@ void appendColliderGeometry(const sim::Collider& collider, ColliderGeometry& out
       // Drawn `inset` inside: a rounded box's surface moved in by the inset is the box's half
       // extents and its radius each less the inset (sharp where the radius is less than it).
       const double r = std::min({std::max(s.rounding - inset, 0.0), h.x, h.y, h.z});
-      if (r > 0.0) {
+      // (A radius far under the box's size draws as sharp: there is nothing to see of it.)
+      if (r > 1e-9 * std::max({h.x, h.y, h.z})) {
         roundedBox(frame, h, r, out);
         return;
       }
