@@ -102,8 +102,9 @@ Camera fromAbove(double height) {
 // (each corner one of its points) covering the surface's area, that of the inner box (the half
 // extents less the radius, all less the inset) grown by the radius: its faces, a quarter cylinder
 // along each edge and an eighth of a sphere at each corner, less what the chords of 11.25 degrees
-// cut off (0.6 % where the radius is the smallest half extent; a face missing would take 10 %). Turned, moved, and rounded by a radius more and less than the inset, by the smallest half
-// extent (the inner box flat), and by 1e-17 m (drawn sharp).
+// cut off (0.6 % where the radius is the smallest half extent; a face missing would take 10 %). Turned, moved, and
+// rounded by a radius more and less than the inset, by the smallest half extent (the inner box flat), and by 1e-17 m
+// (drawn sharp).
 TEST(ColliderGeometry, ARoundedBoxIsDrawnOnItsSurface) {
   const double pi = 3.141592653589793;
   for (const double rounding : {0.0, 1e-17, 0.001, 0.05, 0.35}) {
