@@ -63,6 +63,11 @@ struct TimingLog {
     return *middle;
   }
   std::string summary(int width, int height) const {
+    if (frame.size() <= kWarmUp) {
+      return "timings: none: the first " + std::to_string(kWarmUp) +
+             " frames are left out as warm-up and no frame came after them (run more, --exit-after " +
+             std::to_string(kWarmUp + 1) + " or more)";
+    }
     const double frameMs = median(frame);
     char line[320];
     std::snprintf(line, sizeof line,

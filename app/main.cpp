@@ -1,5 +1,8 @@
 // drape: the desktop app. `drape --help` lists its options; docs/app.md its bindings.
+#include <cctype>
+#include <filesystem>
 #include <iostream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -17,8 +20,20 @@ int main(int argc, char** argv) {
   cli.add_option("--exit-after", options.exitAfter, "Quit after N frames")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000000}));
   cli.add_option("--out", options.out, "At exit, write the final state (JSON, as drape-cli run --out)");
-  cli.add_option("--width", options.width, "Window width in points")->check(CLI::Range(64, 16384));
-  cli.add_option("--height", options.height, "Window height in points")->check(CLI::Range(64, 16384));
+  // A size that is not a whole number says so (the range check alone called "abc" out of range).
+  const CLI::Validator whole(
+      [](std::string& text) {
+        std::size_t used = 0;
+        try {
+          (void)std::stoi(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        return used == text.size() && !text.empty() ? std::string() : text + ": expected a whole number";
+      },
+      "");
+  cli.add_option("--width", options.width, "Window width in points")->check(whole)->check(CLI::Range(64, 16384));
+  cli.add_option("--height", options.height, "Window height in points")->check(whole)->check(CLI::Range(64, 16384));
   cli.add_option("--threads", options.threads, "Simulation threads (default: every core, at most 8)")
       ->check(CLI::Range(1, 8));
   cli.add_option("--render-scale", options.renderScale,
@@ -39,6 +54,16 @@ int main(int argc, char** argv) {
       }
       if (used != screenshot[0].size() || frames < 1) {
         throw CLI::ValidationError("--screenshot-after", screenshot[0] + ": expected a frame count of at least 1");
+      }
+      if (options.exitAfter && frames > *options.exitAfter) {
+        throw CLI::ValidationError("--screenshot-after", screenshot[0] + ": the app quits after frame " +
+                                                             std::to_string(*options.exitAfter) +
+                                                             " (--exit-after), before it");
+      }
+      std::string extension = std::filesystem::path(screenshot[1]).extension().string();
+      for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (extension != ".png") {
+        throw CLI::ValidationError("--screenshot-after", screenshot[1] + ": expected a .png file (it writes PNG)");
       }
       options.screenshotAfter = frames;
       options.screenshotFile = screenshot[1];

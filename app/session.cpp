@@ -64,6 +64,8 @@ void Session::adopt(scene::Scene scene, std::unique_ptr<sim::World> world, const
     redo_.clear();
   };
   interaction_->tell = [this](const std::string& line) { status = line; };
+  // Nothing to hold yet (empty-table): the first thing to do is draw a cloth.
+  if (world_->cloths().empty()) interaction_->setMode(interact::Mode::create);
   undo_.clear();
   redo_.clear();
   seams_.clear();
@@ -194,7 +196,13 @@ void Session::frame(glm::dvec3 lower, glm::dvec3 upper, double yaw, double pitch
 
 void Session::resetView() {
   glm::dvec3 lower, upper;
-  render::sceneBounds(*world_, lower, upper);
+  // A collider that moves (rising-sphere's ball, which lifts the cloth a metre in its 4 s) framed
+  // where the scene's duration takes it too; and nothing under the table, which hides it (the ball
+  // starts there).
+  render::sceneBounds(*world_, lower, upper, scene_.duration);
+  if (const std::optional<double> table = tableHeight(*world_); table && *table < upper.y) {
+    lower.y = std::max(lower.y, *table);
+  }
   const bool onlyTable =
       world_->cloths().empty() &&
       std::all_of(world_->colliders().begin(), world_->colliders().end(),

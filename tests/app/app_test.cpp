@@ -376,6 +376,19 @@ TEST_F(App, ABadSceneOrScriptIsBadInput) {
   EXPECT_NE(read(file("err.txt")).find("bad.json: events.0.type: expected one of"), std::string::npos);
   status = std::system((app + " desk --screenshot-after x y.png 2>'" + err + "'").c_str());
   EXPECT_EQ(WEXITSTATUS(status), 2);
+  // A picture the run would never take (the app quits first), or in a format it does not write,
+  // and a size that is not a number: each refused before a window opens, in one line.
+  const std::pair<const char*, const char*> refused[] = {
+      {"--exit-after 10 --screenshot-after 50 y.png", "--screenshot-after: 50: the app quits after frame 10"},
+      {"--screenshot-after 5 y.jpg", "--screenshot-after: y.jpg: expected a .png file"},
+      {"--height abc", "--height: abc: expected a whole number"}};
+  for (const auto& [options, message] : refused) {
+    status = std::system((app + " desk " + options + " 2>'" + err + "'").c_str());
+    EXPECT_EQ(WEXITSTATUS(status), 2) << options;
+    const std::string said = read(file("err.txt"));
+    EXPECT_EQ(said.rfind(std::string("drape: error: ") + message, 0), 0u) << said;
+    EXPECT_EQ(std::count(said.begin(), said.end(), '\n'), 1) << said;
+  }
 }
 
 }  // namespace

@@ -229,6 +229,38 @@ TEST(Session, ASceneThatFailsToLoadLeavesTheCurrentOneRunning) {
   EXPECT_EQ(session.scene().name, "star");
 }
 
+TEST(Session, ASceneWithNoClothOpensInCreateModeAndOneWithAClothInSticky) {
+  // Nothing to hold on an empty table: the first thing to do there is draw (a new user found the
+  // app waiting in Sticky mode on empty-table, dragging nothing).
+  EXPECT_EQ(Session("empty-table").interaction().mode(), interact::Mode::create);
+  EXPECT_EQ(Session("desk").interaction().mode(), interact::Mode::sticky);
+}
+
+TEST(Session, TheFirstViewKeepsAClothAMovingColliderCarriesInViewForTheScenesDuration) {
+  // rising-sphere's ball rises from under the table and lifts the cloth a metre in the scene's 4 s.
+  // Framed on the ball where it started, the cloth rose out of the top of the window by 4 s; now
+  // the first view holds where the ball goes too, left of a panel covering 30 % of the window.
+  Session session("rising-sphere");
+  const double aspect = 16.0 / 10.0, covered = 0.3;
+  session.setView(aspect, covered);
+  session.resetView();
+  const auto steps = static_cast<int>(std::ceil(session.scene().duration / session.world().settings().solver.dt));
+  for (int i = 0; i < steps; ++i) ASSERT_EQ(session.step(), sim::StepStatus::ok);
+  double highest = 0.0;
+  for (const sim::Cloth& cloth : session.world().cloths()) {
+    for (const sim::Vec3& x : cloth.state.position) {
+      highest = std::max(highest, x.y);
+      const std::optional<glm::dvec2> at = session.camera().project(x, aspect);
+      ASSERT_TRUE(at);
+      EXPECT_GE(at->x, 0.0);
+      EXPECT_LE(at->x, 1.0 - covered);
+      EXPECT_GE(at->y, 0.0);
+      EXPECT_LE(at->y, 1.0);
+    }
+  }
+  EXPECT_GT(highest, 0.9);  // it did rise
+}
+
 TEST(Session, UndoTakesBackACutAndADrawnCloth) {
   Session session("desk");
   const std::size_t grid = session.world().cloths()[0].state.position.size();  // before any cut

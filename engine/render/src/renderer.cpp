@@ -274,7 +274,7 @@ void clothBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) 
 namespace {
 
 // The cloths' box [lower, upper] grown to sceneBounds: the finite colliders, the table under it.
-void growToScene(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
+void growToScene(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper, double ahead) {
   for (const sim::Collider& collider : world.colliders()) {
     const sim::ColliderSettings& s = collider.settings();
     // A bounding sphere of each finite shape (planes are endless; meshes use their vertices).
@@ -288,6 +288,11 @@ void growToScene(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) 
     if (radius == 0.0) continue;
     lower = glm::min(lower, collider.centre() - radius);
     upper = glm::max(upper, collider.centre() + radius);
+    const glm::dvec3 later = collider.centre() + s.velocity * ahead;
+    if (ahead > 0.0 && std::isfinite(later.x + later.y + later.z)) {
+      lower = glm::min(lower, later - radius);
+      upper = glm::max(upper, later + radius);
+    }
   }
   if (lower.x > upper.x) {  // nothing in the world: frame the table around the origin
     lower = glm::dvec3{-1.0, 0.0, -1.0};
@@ -298,9 +303,9 @@ void growToScene(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) 
 
 }  // namespace
 
-void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper) {
+void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper, double ahead) {
   clothBounds(world, lower, upper);
-  growToScene(world, lower, upper);
+  growToScene(world, lower, upper, ahead);
 }
 
 struct Renderer::Impl {
@@ -676,7 +681,7 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glm::dvec3 clothLower, clothUpper;
   clothBounds(world, clothLower, clothUpper);
   glm::dvec3 lower = clothLower, upper = clothUpper;
-  growToScene(world, lower, upper);
+  growToScene(world, lower, upper, 0.0);
   const glm::dvec3 centre = (lower + upper) * 0.5;
   const double radius = std::max(0.5, glm::length(upper - lower) * 0.5) * 1.1;
   const glm::mat4 lightView =

@@ -105,8 +105,9 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-// The box around every particle and finite collider of the world (and the table at y = 0 under it).
-void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper);
+// The box around every particle and finite collider of the world (and the table at y = 0 under it);
+// with `ahead` (s), each moving collider also where its velocity takes it in that time.
+void sceneBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper, double ahead = 0.0);
 // The box around every particle of the world; lower > upper where there is none.
 void clothBounds(const sim::World& world, glm::dvec3& lower, glm::dvec3& upper);
 
