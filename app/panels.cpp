@@ -377,8 +377,19 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     panels.panelRect[2] = extent.x;
     panels.panelRect[3] = extent.y;
   }
-  // Widgets leave room on their right for the longest label.
-  ImGui::PushItemWidth(-std::min(ImGui::CalcTextSize("pinch distance (m) ").x, ImGui::GetWindowWidth() * 0.42f));
+  // Widgets leave room on their right for the longest label, and keep at least 64 points
+  // themselves: on a narrow panel (an 800-point window) the labels were cut off at 42 % of it.
+  ImGui::PushItemWidth(-std::max(
+      std::min(ImGui::CalcTextSize("pinch distance (m) ").x, ImGui::GetContentRegionAvail().x - 64.0f), 0.0f));
+  // A button beside the last item only where the panel has room for it (else on the next line):
+  // on a narrow panel "redo" was cut to "re".
+  const auto besideIfRoom = [](const char* label) {
+    const ImGuiStyle& style = ImGui::GetStyle();
+    if (ImGui::GetItemRectMax().x + style.ItemSpacing.x + ImGui::CalcTextSize(label).x + 2.0f * style.FramePadding.x <
+        ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) {
+      ImGui::SameLine();
+    }
+  };
 
   if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
     static const std::vector<ShippedScene> scenes = shippedScenes();
@@ -397,31 +408,25 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
       ImGui::PopTextWrapPos();
     }
     if (ImGui::Button(session.paused ? "run" : "pause")) session.paused = !session.paused;
-    ImGui::SameLine();
+    besideIfRoom("step");
     if (ImGui::Button("step")) {
       // While running, a step pauses first: one step, then still.
       session.paused = true;
       session.step();
     }
     tip("one step (pauses first while running; N or . does the same)");
-    ImGui::SameLine();
+    besideIfRoom("reset");
     if (ImGui::Button("reset")) {
       session.reset();  // a new world: nothing below may use the old one
       ImGui::PopItemWidth();
       ImGui::End();
       return toLoad;
     }
-    ImGui::SameLine();
+    besideIfRoom("undo");
     if (ImGui::Button("undo")) session.undo();
-    ImGui::SameLine();
+    besideIfRoom("redo");
     if (ImGui::Button("redo")) session.redo();
-    // Only beside the rest where the panel is wide enough.
-    const ImGuiStyle& style = ImGui::GetStyle();
-    if (ImGui::GetItemRectMax().x + style.ItemSpacing.x + ImGui::CalcTextSize("screenshot").x +
-            2.0f * style.FramePadding.x <
-        ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) {
-      ImGui::SameLine();
-    }
+    besideIfRoom("screenshot");
     if (ImGui::Button("screenshot")) panels.wantScreenshot = true;
     // Every sheet made of a fabric in physical units (docs/fabric.md), or as the scene says.
     const std::string fabric = session.fabric().empty() ? "as the scene says" : session.fabric();
@@ -476,7 +481,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     sliderReal("pinch height (m)", hands.pinchHeight, 0.0, 1.0);
     sliderReal("lift speed (m/s)", hands.liftSpeed, 0.05, 5.0);
     sliderReal("drawn spacing (m)", hands.spacing, 0.01, 0.2);
-    ImGui::Text("touches %d, parked mouse fingers %d", input.touchesDown(), input.parkedFingers());
+    ImGui::TextWrapped("touches %d, parked mouse fingers %d", input.touchesDown(), input.parkedFingers());
   }
 
   sim::WorldSettings tuned = world.settings();
