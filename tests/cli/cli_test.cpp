@@ -635,7 +635,10 @@ TEST_F(Cli, AStepCountPastTheLimitIsBadInput) {
 
 TEST_F(Cli, MissingSceneFileIsBadInput) {
   expectOneLineError(run("run '" + file("nope.json").string() + "'"), 2, "nope.json: cannot open the scene file");
-  expectOneLineError(run("validate nothing-by-this-name"), 2, "nothing-by-this-name: cannot open the scene file");
+  // A bare name is looked for among the shipped scenes too: its message says where they are listed.
+  expectOneLineError(run("validate nothing-by-this-name"), 2,
+                     "nothing-by-this-name: cannot open the scene file: it does not exist, nor is it a shipped scene "
+                     "(drape-cli scenes lists them)");
 }
 
 TEST_F(Cli, NoSubcommandIsBadInputAndHelpIsNot) {

@@ -478,6 +478,13 @@ std::filesystem::path resolveScenePath(const std::string& nameOrPath) {
 }
 
 Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  // A bare name that is neither a file nor a shipped scene says where the shipped ones are listed.
+  std::error_code ignored;
+  if (file.parent_path().empty() && !std::filesystem::exists(file, ignored)) {
+    throw InputError(printable(file.string(), 200) +
+                     ": cannot open the scene file: it does not exist, nor is it a shipped scene (drape-cli "
+                     "scenes lists them)");
+  }
   json document = readJsonFile(file, "scene file", kMaxSceneFileBytes);
   for (const std::string& assignment : overrides) applyOverride(document, assignment);
   return parseScene(document, file.string());
