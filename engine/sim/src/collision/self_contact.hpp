@@ -227,7 +227,10 @@ class SelfContact {
   std::vector<Vec3> x0_, x_;  // where each particle was when the substep began, and is now
   Real distance_ = 0.0;       // the pairs were found for
   bool reused_ = true;        // the pairs last found served a second substep
-  std::vector<Real> w_;       // inverse masses
+  Real ahead_ = 1.0;          // how many substeps of motion the last search's boxes held
+  int served_ = 0;            // substeps the pairs last found have served, that one included
+  static constexpr Real kMostAhead = 8.0;
+  std::vector<Real> w_;  // inverse masses
   struct Plane {
     std::uint32_t particle;
     std::uint32_t cloth, index;  // of the particle in its cloth
