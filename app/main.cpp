@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app.hpp"
+#include "drape/scene/error.hpp"
 
 int main(int argc, char** argv) {
   drape::app::AppOptions options;
@@ -25,11 +26,14 @@ int main(int argc, char** argv) {
       [](std::string& text) {
         std::size_t used = 0;
         try {
-          (void)std::stoi(text, &used);
+          (void)std::stoll(text, &used);
+        } catch (const std::out_of_range&) {
+          return std::string();  // digits, far out of the range: the range check says so
         } catch (const std::exception&) {
           used = 0;
         }
-        return used == text.size() && !text.empty() ? std::string() : text + ": expected a whole number";
+        return used == text.size() && !text.empty() ? std::string()
+                                                    : drape::scene::printable(text, 80) + ": expected a whole number";
       },
       "");
   cli.add_option("--width", options.width, "Window width in points")->check(whole)->check(CLI::Range(64, 16384));
@@ -53,7 +57,8 @@ int main(int argc, char** argv) {
         used = 0;
       }
       if (used != screenshot[0].size() || frames < 1) {
-        throw CLI::ValidationError("--screenshot-after", screenshot[0] + ": expected a frame count of at least 1");
+        throw CLI::ValidationError("--screenshot-after", drape::scene::printable(screenshot[0], 80) +
+                                                             ": expected a frame count of at least 1");
       }
       if (options.exitAfter && frames > *options.exitAfter) {
         throw CLI::ValidationError("--screenshot-after", screenshot[0] + ": the app quits after frame " +
@@ -63,7 +68,8 @@ int main(int argc, char** argv) {
       std::string extension = std::filesystem::path(screenshot[1]).extension().string();
       for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
       if (extension != ".png") {
-        throw CLI::ValidationError("--screenshot-after", screenshot[1] + ": expected a .png file (it writes PNG)");
+        throw CLI::ValidationError("--screenshot-after", drape::scene::printable(screenshot[1], 200) +
+                                                             ": expected a .png file (it writes PNG)");
       }
       options.screenshotAfter = frames;
       options.screenshotFile = screenshot[1];

@@ -479,8 +479,11 @@ std::filesystem::path resolveScenePath(const std::string& nameOrPath) {
 
 Scene loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   // A bare name that is neither a file nor a shipped scene says where the shipped ones are listed.
-  std::error_code ignored;
-  if (file.parent_path().empty() && !std::filesystem::exists(file, ignored)) {
+  // (Only where the file system says plainly that it is not there: a name it refuses, too long or
+  // in a folder it may not read, is left for the reader to report.)
+  std::error_code error;
+  const bool there = std::filesystem::exists(file, error);
+  if (file.parent_path().empty() && !there && !error) {
     throw InputError(printable(file.string(), 200) +
                      ": cannot open the scene file: it does not exist, nor is it a shipped scene (drape-cli "
                      "scenes lists them)");

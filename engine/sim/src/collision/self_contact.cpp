@@ -536,10 +536,12 @@ void SelfContact::listEdgeEdge(std::uint32_t e, std::uint32_t f, std::vector<Pai
 void SelfContact::findPairs(Real distance, Real ahead, Workers& workers) {
   const std::size_t n = x_.size(), nt = triangles_.size(), ne = edges_.size();
   // Boxes: each particle's motion, from x0 on for `ahead` times its motion in this substep (the
-  // substeps left in the step: the pairs then serve for all of them while the particles keep
-  // within), grown by `distance`, so that two boxes overlap wherever two primitives may come within
-  // twice that. The solve may push a particle up to `distance` beyond, before the pairs must be found
-  // again (SelfContact::strays).
+  // substeps left in the step, or more for a cloth carried along: findPairsIfNeeded; the pairs then
+  // serve for all of them while the particles keep within), grown by `distance`, so that two boxes
+  // overlap wherever two primitives may come within twice that. The solve may push a particle up to
+  // `distance` beyond, before the pairs must be found again (SelfContact::strays).
+  ahead_ = ahead;
+  served_ = 1;
   const Real grow = distance;
   lower_.resize(n + nt + ne);
   upper_.resize(n + nt + ne);
@@ -1717,7 +1719,7 @@ void SelfContact::findPairsIfNeeded(std::vector<ClothRecord>& cloths, const Self
     if (!strays_.empty() && few) refresh(strays_, workers);
     if (few) {
       reused_ = true;
-      ++served_;
+      served_ = std::min(served_ + 1, kMostServed);  // (counted no further than it is compared)
       return;
     }
   }
@@ -1734,8 +1736,6 @@ void SelfContact::findPairsIfNeeded(std::vector<ClothRecord>& cloths, const Self
     if (together && served_ >= ahead_) ahead = std::max(ahead, std::min(2.0 * ahead_, kMostAhead));
   }
   findPairs(settings.distance, ahead, workers);
-  ahead_ = ahead;
-  served_ = 1;
   distance_ = settings.distance;
   reused_ = false;
 }

@@ -230,6 +230,7 @@ class SelfContact {
   Real ahead_ = 1.0;          // how many substeps of motion the last search's boxes held
   int served_ = 0;            // substeps the pairs last found have served, that one included
   static constexpr Real kMostAhead = 8.0;
+  static constexpr int kMostServed = 1000;
   std::vector<Real> w_;  // inverse masses
   struct Plane {
     std::uint32_t particle;
