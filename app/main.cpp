@@ -2,12 +2,35 @@
 #include <cctype>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "app.hpp"
 #include "drape/scene/error.hpp"
+
+namespace {
+
+// `text` read whole as an integer, or nothing where it is not one; `tooLarge` says whether it was
+// digits past what a long long holds.
+std::optional<long long> wholeNumber(const std::string& text, bool& tooLarge) {
+  tooLarge = false;
+  std::size_t used = 0;
+  long long value = 0;
+  try {
+    value = std::stoll(text, &used);
+  } catch (const std::out_of_range&) {
+    tooLarge = true;
+    return std::nullopt;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != text.size()) return std::nullopt;
+  return value;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   drape::app::AppOptions options;
@@ -24,16 +47,11 @@ int main(int argc, char** argv) {
   // A size that is not a whole number says so (the range check alone called "abc" out of range).
   const CLI::Validator whole(
       [](std::string& text) {
-        std::size_t used = 0;
-        try {
-          (void)std::stoll(text, &used);
-        } catch (const std::out_of_range&) {
-          return std::string();  // digits, far out of the range: the range check says so
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        return used == text.size() && !text.empty() ? std::string()
-                                                    : drape::scene::printable(text, 80) + ": expected a whole number";
+        bool tooLarge = false;
+        // (Digits far out of the range: the range check says so.)
+        return wholeNumber(text, tooLarge) || tooLarge
+                   ? std::string()
+                   : drape::scene::printable(text, 80) + ": expected a whole number";
       },
       "");
   cli.add_option("--width", options.width, "Window width in points")->check(whole)->check(CLI::Range(64, 16384));
@@ -49,14 +67,10 @@ int main(int argc, char** argv) {
   try {
     cli.parse(argc, argv);
     if (!screenshot.empty()) {
-      std::size_t used = 0;
-      long long frames = 0;
-      try {
-        frames = std::stoll(screenshot[0], &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != screenshot[0].size() || frames < 1) {
+      bool tooLarge = false;
+      const std::optional<long long> read = wholeNumber(screenshot[0], tooLarge);
+      const long long frames = read.value_or(0);
+      if (frames < 1) {
         throw CLI::ValidationError("--screenshot-after", drape::scene::printable(screenshot[0], 80) +
                                                              ": expected a frame count of at least 1");
       }
