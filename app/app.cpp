@@ -635,8 +635,9 @@ int runApp(const AppOptions& options) {
         }
         if (toLoad) session->load(*toLoad);  // on failure the message is in the status line and the scene stays
         remap();                             // a load, reset or model change made a new interaction
-        if (options.screenshotAfter && frame + 1 == *options.screenshotAfter && options.screenshotFile) {
-          const std::string said = screenshot(*renderer, size, *options.screenshotFile);
+        for (const auto& [after, file] : options.screenshots) {
+          if (frame + 1 != after) continue;
+          const std::string said = screenshot(*renderer, size, file);
           if (said.rfind("screenshot: ", 0) != 0) {
             std::cerr << "drape: error: " << said << "\n";
             exitCode = 2;
@@ -668,13 +669,22 @@ int runApp(const AppOptions& options) {
     }
 
     if (options.out) {
-      try {
-        scene::writeFileAtomically(*options.out,
-                                   scene::stateDocument(session->scene(), session->world())
-                                           .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
-                                       "\n");
-      } catch (const scene::InputError& error) {
-        std::cerr << "drape: error: " << error.what() << "\n";
+      // A snapshot (NAME.drape.json) as the panel's save writes it, else the state as drape-cli's.
+      std::optional<std::string> failed;
+      if (isSnapshot(*options.out)) {
+        failed = session->save(*options.out);
+      } else {
+        try {
+          scene::writeFileAtomically(*options.out,
+                                     scene::stateDocument(session->scene(), session->world())
+                                             .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                                         "\n");
+        } catch (const scene::InputError& error) {
+          failed = error.what();
+        }
+      }
+      if (failed) {
+        std::cerr << "drape: error: " << *failed << "\n";
         exitCode = 2;
       }
     }

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace drape::app {
 
@@ -13,11 +15,11 @@ namespace drape::app {
 inline constexpr int kExitNoDisplay = 4;
 
 struct AppOptions {
-  std::string scene = "desk";                   // a scene (path or shipped name) or a snapshot (*.drape.json)
-  std::optional<std::string> replay;            // gesture script, pushed through SDL as touch events
-  std::optional<std::string> record;            // write what the fingers did here at exit
-  std::optional<std::int64_t> screenshotAfter;  // frames
-  std::optional<std::string> screenshotFile;
+  std::string scene = "desk";         // a scene (path or shipped name) or a snapshot (*.drape.json)
+  std::optional<std::string> replay;  // gesture script, pushed through SDL as touch events
+  std::optional<std::string> record;  // write what the fingers did here at exit
+  // After frame N (from 1), write the window to this PNG; any number, in any order.
+  std::vector<std::pair<std::int64_t, std::string>> screenshots;
   std::optional<std::int64_t> exitAfter;  // frames
   std::optional<std::string> out;         // final state (JSON) at exit, as drape-cli run --out
   int width = 1280;

@@ -38,12 +38,14 @@ int main(int argc, char** argv) {
   cli.add_option("scene", options.scene, "Scene file, shipped scene name, or snapshot (*.drape.json); default desk");
   cli.add_option("--replay", options.replay, "Play this gesture script as touch events pushed through SDL");
   cli.add_option("--record", options.record, "At exit, write what the fingers did as a gesture script");
-  std::vector<std::string> screenshot;
-  cli.add_option("--screenshot-after", screenshot, "N FILE: after frame N, write the window to FILE (PNG)")
-      ->expected(2);
+  std::vector<std::pair<std::string, std::string>> screenshots;
+  cli.add_option("--screenshot-after", screenshots,
+                 "N FILE: after frame N, write the window to FILE (PNG); repeatable");
   cli.add_option("--exit-after", options.exitAfter, "Quit after N frames")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000000}));
-  cli.add_option("--out", options.out, "At exit, write the final state (JSON, as drape-cli run --out)");
+  cli.add_option(
+      "--out", options.out,
+      "At exit, write the final state (JSON, as drape-cli run --out), or a snapshot the app opens (NAME.drape.json)");
   // A size that is not a whole number says so (the range check alone called "abc" out of range).
   const CLI::Validator whole(
       [](std::string& text) {
@@ -66,27 +68,25 @@ int main(int argc, char** argv) {
                "At exit, print the median milliseconds of a frame and of its parts (simulation, scene, panels, swap)");
   try {
     cli.parse(argc, argv);
-    if (!screenshot.empty()) {
+    for (const auto& [count, file] : screenshots) {
       bool tooLarge = false;
-      const std::optional<long long> read = wholeNumber(screenshot[0], tooLarge);
-      const long long frames = read.value_or(0);
+      const long long frames = wholeNumber(count, tooLarge).value_or(0);
       if (frames < 1) {
-        throw CLI::ValidationError("--screenshot-after", drape::scene::printable(screenshot[0], 80) +
-                                                             ": expected a frame count of at least 1");
+        throw CLI::ValidationError("--screenshot-after",
+                                   drape::scene::printable(count, 80) + ": expected a frame count of at least 1");
       }
       if (options.exitAfter && frames > *options.exitAfter) {
-        throw CLI::ValidationError("--screenshot-after", screenshot[0] + ": the app quits after frame " +
-                                                             std::to_string(*options.exitAfter) +
-                                                             " (--exit-after), before it");
+        throw CLI::ValidationError("--screenshot-after",
+                                   drape::scene::printable(count, 80) + ": the app quits after frame " +
+                                       std::to_string(*options.exitAfter) + " (--exit-after), before it");
       }
-      std::string extension = std::filesystem::path(screenshot[1]).extension().string();
+      std::string extension = std::filesystem::path(file).extension().string();
       for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
       if (extension != ".png") {
-        throw CLI::ValidationError("--screenshot-after", drape::scene::printable(screenshot[1], 200) +
-                                                             ": expected a .png file (it writes PNG)");
+        throw CLI::ValidationError("--screenshot-after",
+                                   drape::scene::printable(file, 200) + ": expected a .png file (it writes PNG)");
       }
-      options.screenshotAfter = frames;
-      options.screenshotFile = screenshot[1];
+      options.screenshots.emplace_back(frames, file);
     }
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return cli.exit(error);

@@ -25,14 +25,10 @@ int FixedStepper::advance(double elapsed, double dt) {
   return steps;
 }
 
-namespace {
-
 bool isSnapshot(const std::filesystem::path& file) {
   const std::string name = file.filename().string();
   return name.size() > 11 && name.substr(name.size() - 11) == ".drape.json";
 }
-
-}  // namespace
 
 Session::Session(const std::filesystem::path& scene) {
   if (const std::optional<std::string> error = load(scene)) throw scene::InputError(*error);

@@ -137,6 +137,31 @@ TEST_F(App, AHundredFingersAtOnceAreFine) {
   }
 }
 
+// `--out NAME.drape.json` saves a snapshot, as the panel's save does, and the app opens it where
+// it was: drape-sphere's cloth fallen onto its ball, carried on one frame, not started again.
+TEST_F(App, OutSavesASnapshotTheAppOpensWhereItWasAndScreenshotsRepeat) {
+  const auto meanY = [](const json& positions) {
+    double y = 0.0;
+    for (const json& p : positions) y += p[1].get<double>();
+    return y / static_cast<double>(positions.size());
+  };
+  // (Two screenshots on the way: --screenshot-after is repeatable, in any order.)
+  ASSERT_EQ(inDisplay("\"$DRAPE\" drape-sphere --width 480 --height 320 --exit-after 60 --out fallen.drape.json "
+                      "--screenshot-after 60 late.png --screenshot-after 2 early.png")
+                .exitCode,
+            0);
+  ASSERT_TRUE(fs::exists(file("early.png")) && fs::exists(file("late.png")));
+  EXPECT_NE(read(file("early.png")), read(file("late.png"))) << "the cloth fell between them";
+  const json saved = state(file("fallen.drape.json"));
+  ASSERT_EQ(saved["drapeSnapshot"], 1);
+  const double fallen = meanY(saved["cloths"][0]["positions"]);
+  EXPECT_LT(fallen, meanY(saved["cloths"][0]["restPositions"]) - 0.05) << "a second of falling";
+  const Result again =
+      inDisplay("\"$DRAPE\" fallen.drape.json --width 480 --height 320 --exit-after 1 --out again.json");
+  ASSERT_EQ(again.exitCode, 0) << again.err;
+  EXPECT_NEAR(meanY(state(file("again.json"))["cloths"][0]["positions"]), fallen, 0.01);
+}
+
 // The desk in a 640 x 400 window, `first` done (keys), then a left drag from the middle 140 points
 // to the right with xdotool, and Esc twice; the state at exit is in dragged.json.
 std::string dragAcrossTheDesk(const std::string& first) {

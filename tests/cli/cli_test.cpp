@@ -641,6 +641,31 @@ TEST_F(Cli, MissingSceneFileIsBadInput) {
                      "(drape-cli scenes lists them)");
 }
 
+// `--out NAME.drape.json` writes a snapshot (what the app's save writes and opens) of the same
+// world the state beside it describes; and either, given where a scene goes, is named for what it is.
+TEST_F(Cli, OutWritesASnapshotTheAppOpensAndNeitherOutputPassesForAScene) {
+  const fs::path state = file("s.json"), snapshot = file("s.drape.json");
+  const Result result =
+      run("run drape-sphere --time 0.3 --quiet --out '" + state.string() + "' --out '" + snapshot.string() + "'");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const json stateDocument = json::parse(read(state)), snapshotDocument = json::parse(read(snapshot));
+  EXPECT_EQ(snapshotDocument["drapeSnapshot"], 1);
+  EXPECT_EQ(snapshotDocument["scene"]["name"], "drape-sphere");
+  EXPECT_DOUBLE_EQ(snapshotDocument["time"].get<double>(), stateDocument["time"].get<double>());
+  const json& positions = snapshotDocument["cloths"][0]["positions"];
+  ASSERT_EQ(positions.size(), stateDocument["cloths"][0]["positions"].size());
+  EXPECT_EQ(positions, stateDocument["cloths"][0]["positions"]);  // the cloth has fallen: not its start
+  EXPECT_NE(positions, snapshotDocument["cloths"][0]["restPositions"]);
+  expectOneLineError(run("run '" + state.string() + "'"), 2,
+                     state.string() + ": a state drape-cli wrote (the positions alone), not a scene");
+  const fs::path renamed = file("renamed.json");
+  fs::copy_file(snapshot, renamed);
+  expectOneLineError(run("validate '" + renamed.string() + "'"), 2,
+                     renamed.string() + ": a snapshot, not a scene: the app opens it");
+  expectOneLineError(run("run drape-sphere --steps 1 --out '" + file("s.txt").string() + "'"), 2,
+                     "expected a file ending in .json (state), .drape.json (a snapshot the app opens) or .obj");
+}
+
 TEST_F(Cli, NoSubcommandIsBadInputAndHelpIsNot) {
   EXPECT_EQ(run("").exitCode, 2);
   const Result help = run("--help");

@@ -15,6 +15,7 @@
 #include "drape/scene/error.hpp"
 #include "drape/scene/output.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/scene/snapshot.hpp"
 #include "drape/sim/intersections.hpp"
 #include "drape/sim/metrics.hpp"
 #include "drape/sim/world.hpp"
@@ -43,13 +44,20 @@ unsigned countPieces(const sim::World& world) {
   return count;
 }
 
-enum class OutputKind { state, mesh };
+enum class OutputKind { state, snapshot, mesh };
 
 OutputKind outputKind(const std::string& file) {
-  const std::string extension = std::filesystem::path(file).extension().string();
-  if (extension == ".json") return OutputKind::state;
-  if (extension == ".obj") return OutputKind::mesh;
-  throw scene::InputError("--out " + file + ": expected a file ending in .json (state) or .obj (mesh)");
+  const std::string name = std::filesystem::path(file).filename().string();
+  const auto endsWith = [&](std::string_view tail) {
+    return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  // A snapshot is what the app's save writes and opens: the scene and every cloth whole.
+  if (endsWith(".drape.json")) return OutputKind::snapshot;
+  if (endsWith(".json")) return OutputKind::state;
+  if (endsWith(".obj")) return OutputKind::mesh;
+  throw scene::InputError("--out " + file +
+                          ": expected a file ending in .json (state), .drape.json (a snapshot the app opens) or .obj "
+                          "(mesh)");
 }
 
 void rejectBadOutputs(const RunArguments& arguments) {
@@ -172,11 +180,15 @@ int run(const RunArguments& arguments) {
 
     std::vector<scene::OutputFile> files;
     for (const std::string& file : arguments.outputs) {
+      const OutputKind kind = outputKind(file);
       files.push_back(
           {file,
-           outputKind(file) == OutputKind::state
-               ? scene::stateDocument(scene, world).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"
-               : scene::objText(world)});
+           kind == OutputKind::mesh ? scene::objText(world)
+           : kind == OutputKind::snapshot
+               ? scene::snapshotDocument(scene, world).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                     "\n"
+               : scene::stateDocument(scene, world).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+                     "\n"});
     }
     if (arguments.traceOut) files.push_back({*arguments.traceOut, trace.str()});
     if (arguments.intersectionsOut) files.push_back({*arguments.intersectionsOut, intersections.str()});

@@ -43,7 +43,9 @@ void addLengthOptions(CLI::App* command, std::optional<std::int64_t>& steps, std
 
 // --out, --intersections-every/out and --quiet of run and replay.
 void addRunOutputs(CLI::App* command, RunArguments& arguments) {
-  command->add_option("--out", arguments.outputs, "Write the final state (.json) or mesh (.obj) (repeatable)");
+  command->add_option(
+      "--out", arguments.outputs,
+      "Write the final state (.json), a snapshot the app opens (.drape.json) or the mesh (.obj) (repeatable)");
   CLI::Option* every = command
                            ->add_option("--intersections-every", arguments.intersectionsEvery,
                                         "Count intersecting triangle pairs at step 0, every K steps and the last step")

@@ -240,6 +240,18 @@ Scene parseScene(const json& document, const std::string& source) {
   scene.source = source;
   scene.document = document.dump(-1, ' ', false, json::error_handler_t::replace);
   ObjectReader root(document, "", source);
+  // What drape-cli and the app write, given where a scene goes: said as what it is, not as the
+  // first scene key it lacks.
+  if (root.has("drapeSnapshot")) {
+    throw InputError(source +
+                     ": a snapshot, not a scene: the app opens it (and drape-cli writes one) under a name ending in "
+                     ".drape.json");
+  }
+  if (root.has("steps") && root.has("metrics") && root.has("cloths") && !root.has("duration")) {
+    throw InputError(source +
+                     ": a state drape-cli wrote (the positions alone), not a scene: `--out NAME.drape.json` writes "
+                     "a snapshot the app opens");
+  }
   scene.name = root.text("name", std::filesystem::path(source).stem().string());
   scene.description = root.text("description", "");
   scene.duration = root.number("duration", 5.0, {0.0, 1.0e5, true, "s"});
