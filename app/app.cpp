@@ -494,7 +494,13 @@ int runApp(const AppOptions& options) {
       const interact::GestureScript& s = replay->script();
       session->interaction().settings() = s.settings;
       session->interaction().settings().material = scene::drawnClothTemplate(session->scene());
-      if (s.camera) session->camera() = *s.camera;
+      if (s.camera) {
+        session->camera() = *s.camera;
+      } else {
+        // Framed to hold where the fingers go too: the tear pulls its pieces 40 cm apart and more,
+        // one of them behind the panel from the scene's own view.
+        session->alsoFrame(Session::worldPoints(s));
+      }
     }
     std::unique_ptr<InputMapper> input;
     interact::Interaction* mapped = nullptr;

@@ -196,6 +196,10 @@ void Session::resetView() {
   // where the scene's duration takes it too; and nothing under the table, which hides it (the ball
   // starts there).
   render::sceneBounds(*world_, lower, upper, scene_.duration);
+  for (const glm::dvec3& point : alsoFramed_) {
+    lower = glm::min(lower, point);
+    upper = glm::max(upper, point);
+  }
   if (const std::optional<double> table = tableHeight(*world_); table && *table < upper.y) {
     lower.y = std::max(lower.y, *table);
   }
@@ -211,6 +215,14 @@ void Session::resetView() {
     upper = glm::dvec3{0.4, y + 0.1, 0.4};
   }
   frame(lower, upper, kYaw, kPitch);
+}
+
+std::vector<glm::dvec3> Session::worldPoints(const interact::GestureScript& script) {
+  std::vector<glm::dvec3> points;
+  for (const interact::GestureEvent& e : script.events) {
+    if (e.pointer && e.pointer->kind == interact::Pointer::Kind::world) points.push_back(e.pointer->world);
+  }
+  return points;
 }
 
 void Session::frameCloths() {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "drape/interact/interaction.hpp"
+#include "drape/interact/replay.hpp"
 #include "drape/render/camera.hpp"
 #include "drape/scene/scene.hpp"
 #include "drape/sim/world.hpp"
@@ -89,8 +90,12 @@ class Session {
   // The window the camera draws into: its aspect, and the fraction of its width the panels cover
   // on the right. Framing centres the scene in the part left uncovered.
   void setView(double aspect, double coveredRight);
-  // The camera as a scene starts: the whole scene from the front right (Home).
+  // The camera as a scene starts: the whole scene from the front right (Home), and the points
+  // `alsoFrame` gave (a replayed gesture's: where its fingers go).
   void resetView();
+  void alsoFrame(std::vector<glm::dvec3> points) { alsoFramed_ = std::move(points); }
+  // A gesture script's world points (where it puts its fingers down and moves them).
+  static std::vector<glm::dvec3> worldPoints(const interact::GestureScript& script);
   // The cloths, as they are now, filling the view from where the camera looks now (F).
   void frameCloths();
   // Keeps the eye above the table (a plane collider facing up), so orbiting cannot hide the scene
@@ -128,6 +133,7 @@ class Session {
   std::vector<Undo> undo_;
   std::vector<Undo> redo_;  // spawn: the cloth taken back; cut, tear: the cloths as the undo found them
   std::vector<Seam> seams_;
+  std::vector<glm::dvec3> alsoFramed_;
   // While tearing is on: the cloths as their topology stood before the step (copied once after
   // each change of it), for undoing a tear.
   std::vector<sim::Cloth> shape_;

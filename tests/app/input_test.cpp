@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "drape/scene/gesture.hpp"
 #include "drape/sim/metrics.hpp"
 #include "input.hpp"
 #include "session.hpp"
@@ -259,6 +260,29 @@ TEST(Session, TheFirstViewKeepsAClothAMovingColliderCarriesInViewForTheScenesDur
     }
   }
   EXPECT_GT(highest, 0.9);  // it did rise
+}
+
+TEST(Session, AReplayedGesturesFirstViewHoldsWhereItsFingersGo) {
+  // The tear pulls one piece 40 cm off to the right and lifts it: from the desk's own first view,
+  // beside a panel covering 30 % of the window, that went behind the panel.
+  Session session("desk-tear");
+  const double aspect = 16.0 / 10.0, covered = 0.3;
+  session.setView(aspect, covered);
+  const std::vector<glm::dvec3> points =
+      Session::worldPoints(scene::loadGesture(std::filesystem::path(DRAPE_ASSET_DIR) / "gestures" / "tear.json"));
+  ASSERT_GE(points.size(), 6u);
+  const auto allInView = [&] {
+    for (const glm::dvec3& p : points) {
+      const std::optional<glm::dvec2> at = session.camera().project(p, aspect);
+      if (!at || at->x < 0.0 || at->x > 1.0 - covered || at->y < 0.0 || at->y > 1.0) return false;
+    }
+    return true;
+  };
+  session.resetView();
+  EXPECT_FALSE(allInView()) << "the scene's own view (what this test is about)";
+  session.alsoFrame(points);
+  session.resetView();
+  EXPECT_TRUE(allInView());
 }
 
 TEST(Session, UndoTakesBackACutAndADrawnCloth) {
