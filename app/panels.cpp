@@ -123,10 +123,16 @@ bool vector3(const char* label, sim::Vec3& value, float speed) {
 
 void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  ImGui::SetNextWindowPos(ImVec2(10, 10));
-  ImGui::SetNextWindowBgAlpha(0.55f);
   // No wider than the window leaves beside the panel, and never half of it: long lines wrap.
   const float room = std::max(120.0f, std::min(display.x * 0.5f, display.x - panels.panelWidth - 30.0f));
+  // Under the collapsed panel's title bar where they would meet (a small window: at 320 x 240 the
+  // title lay across the HUD's first lines).
+  float top = 10.0f;
+  if (panels.panelCollapsed && panels.panelRect[0] < 10.0f + room) {
+    top = std::max(top, panels.panelRect[1] + panels.panelRect[3] + 4.0f);
+  }
+  ImGui::SetNextWindowPos(ImVec2(10, top));
+  ImGui::SetNextWindowBgAlpha(0.55f);
   ImGui::SetNextWindowSizeConstraints(ImVec2(0.0f, 0.0f), ImVec2(room, display.y * 0.6f));
   ImGui::Begin("HUD", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoSavedSettings |
@@ -365,6 +371,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   ImGui::Begin("Drape");
   noteWindow(panels);
   panels.panelWidth = ImGui::IsWindowCollapsed() ? 0.0f : ImGui::GetWindowSize().x + 10.0f;
+  panels.panelCollapsed = ImGui::IsWindowCollapsed();
   {
     const ImVec2 at = ImGui::GetWindowPos(), extent = ImGui::GetWindowSize();
     constexpr float kSlack = 12.0f;  // the margin it is placed with, and a little more
