@@ -213,13 +213,17 @@ void pushTouch(SDL_Window* window, Uint32 type, int finger, glm::dvec2 at) {
 // plane) have no touch event and are applied to the interaction directly.
 class TouchReplay {
  public:
-  TouchReplay(interact::GestureScript script) : script_(std::move(script)), clock_(script_) {}
+  // The script's times count from `startStep`, the world's step as it begins (a snapshot's).
+  TouchReplay(interact::GestureScript script, std::int64_t startStep)
+      : script_(std::move(script)), clock_(script_), startStep_(startStep) {}
 
   const interact::GestureScript& script() const { return script_; }
 
   void beforeStep(SDL_Window* window, Session& session, double aspect) {
     const double dt = session.world().settings().solver.dt;
-    for (const interact::ReplayAction& action : clock_.advance(session.world().time(), dt)) {
+    // (A reset or a load mid-replay puts the clock back: the script waits for it.)
+    const std::int64_t steps = std::max<std::int64_t>(0, session.world().stepCount() - startStep_);
+    for (const interact::ReplayAction& action : clock_.advance(static_cast<double>(steps) * dt, dt)) {
       const interact::GestureEvent& e = script_.events[action.index];
       const std::optional<glm::dvec2> at = action.pointer.kind == interact::Pointer::Kind::screen
                                                ? std::optional<glm::dvec2>(action.pointer.screen)
@@ -292,6 +296,7 @@ class TouchReplay {
  private:
   interact::GestureScript script_;
   interact::ReplayClock clock_;
+  std::int64_t startStep_;
   std::vector<interact::ReplayAction> pending_;
   struct Beside {
     std::optional<interact::Vec3> world;
@@ -490,7 +495,7 @@ int runApp(const AppOptions& options) {
     recording.camera = session->camera();
     std::optional<TouchReplay> replay;
     if (script) {
-      replay.emplace(std::move(*script));
+      replay.emplace(std::move(*script), session->world().stepCount());
       const interact::GestureScript& s = replay->script();
       session->interaction().settings() = s.settings;
       session->interaction().settings().material = scene::drawnClothTemplate(session->scene());

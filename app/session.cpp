@@ -25,10 +25,7 @@ int FixedStepper::advance(double elapsed, double dt) {
   return steps;
 }
 
-bool isSnapshot(const std::filesystem::path& file) {
-  const std::string name = file.filename().string();
-  return name.size() > 11 && name.substr(name.size() - 11) == ".drape.json";
-}
+bool isSnapshot(const std::filesystem::path& file) { return scene::isSnapshotName(file); }
 
 Session::Session(const std::filesystem::path& scene) {
   if (const std::optional<std::string> error = load(scene)) throw scene::InputError(*error);

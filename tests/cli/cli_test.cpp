@@ -661,9 +661,37 @@ TEST_F(Cli, OutWritesASnapshotTheAppOpensAndNeitherOutputPassesForAScene) {
   const fs::path renamed = file("renamed.json");
   fs::copy_file(snapshot, renamed);
   expectOneLineError(run("validate '" + renamed.string() + "'"), 2,
-                     renamed.string() + ": a snapshot, not a scene: the app opens it");
+                     renamed.string() + ": a snapshot, not a scene: the app and drape-cli open it as one");
   expectOneLineError(run("run drape-sphere --steps 1 --out '" + file("s.txt").string() + "'"), 2,
                      "expected a file ending in .json (state), .drape.json (a snapshot the app opens) or .obj");
+}
+
+// A snapshot goes on where it was saved, clock and all: rising-sphere's ball rises on from where it
+// was, and a run of 1 s then 1 s more from its snapshot ends bit for bit as a run of 2 s. A gesture
+// played on a snapshot counts its times from there: the tear played on the desk-tear cloth saved
+// after lying still for 0.5 s ends as the tear played from the start.
+TEST_F(Cli, ASnapshotGoesOnWhereItWasSavedBitForBit) {
+  const fs::path half = file("half.drape.json"), whole = file("whole.json"), resumed = file("resumed.json");
+  ASSERT_EQ(run("run rising-sphere --time 1 --quiet --out '" + half.string() + "'").exitCode, 0);
+  ASSERT_EQ(run("run rising-sphere --time 2 --quiet --out '" + whole.string() + "'").exitCode, 0);
+  const Result going = run("run '" + half.string() + "' --time 1 --quiet --out '" + resumed.string() + "'");
+  ASSERT_EQ(going.exitCode, 0) << going.err;
+  const json a = json::parse(read(whole)), b = json::parse(read(resumed));
+  EXPECT_EQ(a["time"], b["time"]);
+  EXPECT_EQ(a["cloths"][0]["positions"], b["cloths"][0]["positions"]);
+  const Result valid = run("validate '" + half.string() + "'");
+  EXPECT_EQ(valid.exitCode, 0) << valid.err;
+  expectOneLineError(run("run '" + half.string() + "' --set solver.substeps=2"), 2,
+                     "--set solver.substeps=2: " + half.string() + " is a snapshot, whose scene is as it was saved");
+
+  const fs::path still = file("still.drape.json"), fromStart = file("a.json"), fromStill = file("b.json");
+  const std::string tear = "'" + std::string(DRAPE_ASSET_DIR) + "/gestures/tear.json'";
+  ASSERT_EQ(run("run desk-tear --time 0.5 --quiet --out '" + still.string() + "'").exitCode, 0);
+  ASSERT_EQ(run("replay desk-tear " + tear + " --quiet --out '" + fromStart.string() + "'").exitCode, 0);
+  ASSERT_EQ(run("replay '" + still.string() + "' " + tear + " --quiet --out '" + fromStill.string() + "'").exitCode, 0);
+  const json torn = json::parse(read(fromStart));
+  EXPECT_GT(torn["cloths"][0]["positions"].size(), 32u * 32u);  // it tore
+  EXPECT_EQ(torn["cloths"][0]["positions"], json::parse(read(fromStill))["cloths"][0]["positions"]);
 }
 
 TEST_F(Cli, NoSubcommandIsBadInputAndHelpIsNot) {

@@ -114,8 +114,9 @@ void appendTraceRow(std::ostringstream& csv, const sim::World& world, const Trac
 
 int validate(const SceneArguments& arguments) {
   try {
-    const scene::Scene scene = loadScene(arguments);
-    const sim::World world = makeWorld(scene);
+    const Input input = loadInput(arguments);
+    const scene::Scene& scene = input.scene;
+    const sim::World world = input.snapshot ? scene::makeWorld(*input.snapshot) : makeWorld(scene);
     std::cout << scene.source << ": ok: \"" << scene.name << "\", " << world.cloths().size() << " cloth(s), "
               << countParticles(world) << " particles, " << countConstraints(world) << " constraints, "
               << sim::name(scene.world.solver.model) << " model\n";
@@ -127,8 +128,9 @@ int validate(const SceneArguments& arguments) {
 
 int run(const RunArguments& arguments) {
   try {
-    const scene::Scene scene = loadScene(arguments.input);
-    Playback playback(scene, arguments.gesture);
+    const Input input = loadInput(arguments.input);
+    const scene::Scene& scene = input.scene;
+    Playback playback(input, arguments.gesture);
     sim::World& world = playback.world();
     rejectBadOutputs(arguments);  // before running, not after
     const std::int64_t steps = stepCount(scene, arguments.steps, arguments.seconds, playback.script());

@@ -35,6 +35,19 @@ scene::Scene loadScene(const SceneArguments& arguments) {
   return scene::loadScene(scene::resolveScenePath(arguments.scene), arguments.overrides);
 }
 
+Input loadInput(const SceneArguments& arguments) {
+  const std::filesystem::path file = scene::resolveScenePath(arguments.scene);
+  if (!scene::isSnapshotName(file)) return {loadScene(arguments), std::nullopt};
+  if (!arguments.overrides.empty()) {
+    throw scene::InputError("--set " + scene::printable(arguments.overrides.front(), 200) + ": " +
+                            scene::printable(file.string(), 200) +
+                            " is a snapshot, whose scene is as it was saved: set keys on a scene file");
+  }
+  scene::Snapshot snapshot = scene::loadSnapshot(file);
+  scene::Scene scene = snapshot.scene;
+  return {std::move(scene), std::move(snapshot)};
+}
+
 sim::World makeWorld(const scene::Scene& scene) {
   try {
     return sim::World(scene.world);
@@ -60,12 +73,16 @@ std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> st
   return static_cast<std::int64_t>(wanted);
 }
 
-Playback::Playback(const scene::Scene& scene, const std::optional<std::string>& gesture) : world_(makeWorld(scene)) {
+Playback::Playback(const scene::Scene& scene, const std::optional<std::string>& gesture)
+    : Playback(Input{scene, std::nullopt}, gesture) {}
+
+Playback::Playback(const Input& input, const std::optional<std::string>& gesture)
+    : world_(input.snapshot ? scene::makeWorld(*input.snapshot) : makeWorld(input.scene)) {
   if (!gesture) return;
   script_ = scene::loadGesture(*gesture);
   interaction_ = std::make_unique<interact::Interaction>(world_);
   replay_ = std::make_unique<interact::Replay>(world_, *interaction_, *script_);
-  interaction_->settings().material = scene::drawnClothTemplate(scene);
+  interaction_->settings().material = scene::drawnClothTemplate(input.scene);
 }
 
 sim::StepStatus Playback::step() { return replay_ ? replay_->step() : world_.step(); }

@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "drape/interact/replay.hpp"
 #include "drape/scene/scene.hpp"
+#include "drape/scene/snapshot.hpp"
 #include "drape/sim/world.hpp"
 
 namespace drape::cli {
@@ -22,6 +23,14 @@ int badInput(const std::string& message);
 std::filesystem::path outputFolder(const std::string& outDir);
 
 scene::Scene loadScene(const SceneArguments& arguments);
+
+// What run, render and validate take: a scene, or a snapshot (NAME.drape.json: the app's save, or
+// `--out`'s) to go on from, whose scene is as it was saved (no --set).
+struct Input {
+  scene::Scene scene;
+  std::optional<scene::Snapshot> snapshot;
+};
+Input loadInput(const SceneArguments& arguments);
 
 // The engine validates too; its messages are a last line of defence behind the scene reader's.
 sim::World makeWorld(const scene::Scene& scene);
@@ -36,6 +45,8 @@ std::int64_t stepCount(const scene::Scene& scene, std::optional<std::int64_t> st
 class Playback {
  public:
   Playback(const scene::Scene& scene, const std::optional<std::string>& gesture);
+  // A snapshot's world, where there is one, else the scene's.
+  Playback(const Input& input, const std::optional<std::string>& gesture);
   Playback(const Playback&) = delete;
   Playback& operator=(const Playback&) = delete;
 

@@ -28,7 +28,10 @@ const CLI::Validator kDecimal(
     "INT");
 
 void addSceneOptions(CLI::App* command, SceneArguments& arguments) {
-  command->add_option("scene", arguments.scene, "Scene file, or the name of a shipped scene")->required();
+  command
+      ->add_option("scene", arguments.scene,
+                   "Scene file, the name of a shipped scene, or a snapshot (NAME.drape.json) to go on from")
+      ->required();
   command->add_option("--set", arguments.overrides, "Override a key: path=value (repeatable)");
 }
 

@@ -94,8 +94,9 @@ render::Overlay fingerOverlay(const Playback& playback) {
 
 int render(const RenderArguments& arguments) {
   try {
-    const scene::Scene scene = loadScene(arguments.input);
-    Playback playback(scene, arguments.gesture);
+    const Input input = loadInput(arguments.input);
+    const scene::Scene& scene = input.scene;
+    Playback playback(input, arguments.gesture);
     sim::World& world = playback.world();
     int width = 0, height = 0;
     parseSize(arguments.size, width, height);

@@ -88,7 +88,7 @@ std::vector<ReplayAction> ReplayClock::advance(double start, double dt) {
 }
 
 Replay::Replay(sim::World& world, Interaction& interaction, const GestureScript& script)
-    : world_(world), interaction_(interaction), script_(script), clock_(script) {
+    : world_(world), interaction_(interaction), script_(script), clock_(script), startStep_(world.stepCount()) {
   interaction_.settings() = script.settings;
   if (script.camera) interaction_.setCamera(*script.camera, script.aspect);
 }
@@ -118,7 +118,8 @@ void Replay::apply(std::size_t index) {
 
 sim::StepStatus Replay::step() {
   const double dt = world_.settings().solver.dt;
-  for (const ReplayAction& action : clock_.advance(world_.time(), dt)) {
+  const double now = static_cast<double>(world_.stepCount() - startStep_) * dt;
+  for (const ReplayAction& action : clock_.advance(now, dt)) {
     if (action.onTheWay) {
       interaction_.move(script_.events[action.index].finger, action.pointer);
     } else {

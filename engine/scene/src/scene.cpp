@@ -244,7 +244,7 @@ Scene parseScene(const json& document, const std::string& source) {
   // first scene key it lacks.
   if (root.has("drapeSnapshot")) {
     throw InputError(source +
-                     ": a snapshot, not a scene: the app opens it (and drape-cli writes one) under a name ending in "
+                     ": a snapshot, not a scene: the app and drape-cli open it as one under a name ending in "
                      ".drape.json");
   }
   if (root.has("steps") && root.has("metrics") && root.has("cloths") && !root.has("duration")) {

@@ -203,6 +203,12 @@ Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source
   return snapshot;
 }
 
+bool isSnapshotName(const std::filesystem::path& file) {
+  const std::string name = file.filename().string();
+  constexpr std::string_view kTail = ".drape.json";
+  return name.size() > kTail.size() && name.compare(name.size() - kTail.size(), kTail.size(), kTail) == 0;
+}
+
 sim::World makeWorld(const Snapshot& snapshot) {
   try {
     sim::WorldSettings settings = snapshot.scene.world;
@@ -217,6 +223,8 @@ sim::World makeWorld(const Snapshot& snapshot) {
       for (sim::Cloth& cloth : cloths) cloth.state.velocity.clear();
     }
     world.restoreCloths(std::move(cloths));
+    // The clock where it was saved: a moving collider (rising-sphere's ball) goes on from there.
+    world.restoreStepCount(std::llround(snapshot.time / settings.solver.dt));
     return world;
   } catch (const std::invalid_argument& error) {
     throw InputError(snapshot.scene.source + ": " + error.what());

@@ -1329,6 +1329,12 @@ int World::addCloth(const ClothSettings& settings) {
   return static_cast<int>(c);
 }
 
+void World::restoreStepCount(std::int64_t steps) {
+  require(steps >= 0, "a step count must not be negative");
+  stepCount_ = steps;
+  for (Collider& collider : colliders_) collider.setTime(time());
+}
+
 void World::restoreCloths(std::vector<Cloth> cloths) {
   std::size_t particles = 0;
   for (const Cloth& cloth : cloths) {

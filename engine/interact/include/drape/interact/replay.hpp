@@ -7,6 +7,8 @@
 // same time make a jump.
 #pragma once
 
+#include <cstdint>
+
 #include <optional>
 #include <string>
 #include <vector>
@@ -71,6 +73,9 @@ class Replay {
   Interaction& interaction_;
   const GestureScript& script_;
   ReplayClock clock_;
+  // The world's step when the replay began: the script's times count from there (a world loaded
+  // from a snapshot starts where it was saved).
+  std::int64_t startStep_;
   std::vector<std::string> reports_;
 };
 

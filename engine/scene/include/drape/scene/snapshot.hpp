@@ -17,9 +17,13 @@ namespace drape::scene {
 
 struct Snapshot {
   Scene scene;
-  double time = 0.0;  // s, when it was taken (shown, not simulated from)
+  double time = 0.0;  // s, when it was taken: a world made from it goes on from there
   std::vector<sim::Cloth> cloths;
 };
+
+// Whether a file is a snapshot by its name: NAME.drape.json (what the app's save and drape-cli's
+// `--out` write, and what they open as one).
+bool isSnapshotName(const std::filesystem::path& file);
 
 nlohmann::json snapshotDocument(const Scene& scene, const sim::World& world);
 Snapshot loadSnapshot(const std::filesystem::path& file);

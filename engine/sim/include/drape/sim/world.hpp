@@ -289,6 +289,10 @@ class World {
   // consistent (array sizes, indices out of range, a non-finite or non-positive number) or the
   // particles pass the limit.
   void restoreCloths(std::vector<Cloth> cloths);
+  // Puts the clock at `steps` steps from the start (a snapshot taken then), and every collider
+  // where that time takes it, so that a world loaded from a snapshot goes on as the one saved did.
+  // Throws std::invalid_argument, changing nothing, for a negative count.
+  void restoreStepCount(std::int64_t steps);
 
  private:
   void buildPipeline();
