@@ -483,6 +483,7 @@ int runApp(const AppOptions& options) {
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
     ImGuiMouse imguiMouse;
+    std::vector<SDL_Event> heldKeyUps;  // for ImGui in the next frame (below)
     PanelState panels;
     render::Layer panelLayer;  // the main panel's picture (drawImGui)
     if (options.renderScale) {
@@ -546,10 +547,21 @@ int runApp(const AppOptions& options) {
       bool stepOnce = false;
       const InputMapper* mapperBefore = input.get();
       const std::int64_t fingerMovesBefore = input->fingerMoves();
+      // Dear ImGui (1.86) reads a key as held or not when its frame begins: a key pressed and let go
+      // between two frames never reached it. A tap within one frame (xdotool's, or a quick one while
+      // a frame takes long) left a panel's field open after its Return, and the next key and click
+      // went to the field. A release in the frame of its press reaches ImGui in the next frame.
+      for (SDL_Event& released : heldKeyUps) ImGui_ImplSDL2_ProcessEvent(&released);
+      heldKeyUps.clear();
+      std::vector<SDL_Scancode> pressedKeys;
       SDL_Event event;
       while (SDL_PollEvent(&event)) {
         const bool touch = event.type == SDL_FINGERDOWN || event.type == SDL_FINGERMOTION || event.type == SDL_FINGERUP;
-        if (!touch) ImGui_ImplSDL2_ProcessEvent(&event);
+        if (event.type == SDL_KEYDOWN) pressedKeys.push_back(event.key.keysym.scancode);
+        const bool releasedNow = event.type == SDL_KEYUP && std::find(pressedKeys.begin(), pressedKeys.end(),
+                                                                      event.key.keysym.scancode) != pressedKeys.end();
+        if (releasedNow) heldKeyUps.push_back(event);
+        if (!touch && !releasedNow) ImGui_ImplSDL2_ProcessEvent(&event);
         if (event.type == SDL_QUIT) running = false;
         if (event.type == SDL_MOUSEBUTTONDOWN && event.button.which != SDL_TOUCH_MOUSEID) {
           imguiMouse.press(event.button.button);

@@ -243,6 +243,37 @@ TEST_F(App, EscWithTheScenesListOpenClosesTheListAndDoesNotQuit) {
   EXPECT_EQ(result.exitCode, 0) << result.err;
 }
 
+TEST_F(App, AFieldLeftWithReturnGivesTheKeysBackAtOnce) {
+  // The panel's file field (at 1280 x 800, the Scene panel's fourth row): a name typed, Return,
+  // then Ctrl+S and P at once. xdotool's keys are pressed and let go between two frames, which
+  // Dear ImGui 1.86 never saw: the field stayed open after Return, and took the Ctrl+S and the P
+  // as text (no save, no screenshot). Keys sent as a keyboard sends them (XTEST, to the focused
+  // window), not as events sent to the window.
+  const Result result = inDisplay(
+      "\"$DRAPE\" desk --width 1280 --height 800 --exit-after 100000 &\n"
+      "app=$!\n" +
+      kFindWindow +
+      "sleep 1\n"
+      "xdotool windowfocus $window\n"
+      "sleep 0.2\n"
+      "xdotool mousemove --window $window 1010 168 click 1\n"
+      "sleep 0.3\n"
+      "xdotool key ctrl+a\n"
+      "xdotool type --delay 40 typed.drape.json\n"
+      "sleep 0.3\n"
+      "xdotool key Return\n"
+      "sleep 0.5\n"
+      "xdotool key ctrl+s\n"
+      "sleep 0.5\n"
+      "xdotool key p\n"
+      "sleep 1\n"
+      "kill $app\n"
+      "wait $app || true");
+  EXPECT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(fs::exists(file("typed.drape.json"))) << "Ctrl+S saved under the typed name";
+  EXPECT_TRUE(fs::exists(file("drape-screenshot-001.png"))) << "P took a screenshot";
+}
+
 TEST_F(App, ResizingAndMinimisingDoNotStopIt) {
   const Result result = inDisplay(
       "\"$DRAPE\" desk --width 640 --height 400 --exit-after 100000 --out state.json &\n"
