@@ -195,6 +195,21 @@ struct ImGuiMouse {
   }
 };
 
+// An event to Dear ImGui's SDL backend. A key's modifiers are the event's own: the backend (1.86)
+// reads SDL_GetModState(), the state after every event SDL has taken in, so a Ctrl+A pressed and let
+// go within one frame reached it as a plain A (a panel's field then kept its text and took what
+// was typed where it was clicked).
+void toImGui(SDL_Event& event) {
+  ImGui_ImplSDL2_ProcessEvent(&event);
+  if (event.type != SDL_KEYDOWN && event.type != SDL_KEYUP) return;
+  ImGuiIO& io = ImGui::GetIO();
+  const Uint16 mod = event.key.keysym.mod;
+  io.KeyShift = (mod & KMOD_SHIFT) != 0;
+  io.KeyCtrl = (mod & KMOD_CTRL) != 0;
+  io.KeyAlt = (mod & KMOD_ALT) != 0;
+  io.KeySuper = (mod & KMOD_GUI) != 0;
+}
+
 void pushTouch(SDL_Window* window, Uint32 type, int finger, glm::dvec2 at) {
   SDL_Event event{};
   event.type = type;
@@ -483,7 +498,7 @@ int runApp(const AppOptions& options) {
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
     ImGuiMouse imguiMouse;
-    std::vector<SDL_Event> heldKeyUps;  // for ImGui in the next frame (below)
+    std::vector<SDL_Event> heldKeys;  // for ImGui in the next frame (below)
     PanelState panels;
     render::Layer panelLayer;  // the main panel's picture (drawImGui)
     if (options.renderScale) {
@@ -550,18 +565,31 @@ int runApp(const AppOptions& options) {
       // Dear ImGui (1.86) reads a key as held or not when its frame begins: a key pressed and let go
       // between two frames never reached it. A tap within one frame (xdotool's, or a quick one while
       // a frame takes long) left a panel's field open after its Return, and the next key and click
-      // went to the field. A release in the frame of its press reaches ImGui in the next frame.
-      for (SDL_Event& released : heldKeyUps) ImGui_ImplSDL2_ProcessEvent(&released);
-      heldKeyUps.clear();
-      std::vector<SDL_Scancode> pressedKeys;
+      // went to the field. So a release that comes after a press in the same frame reaches ImGui in
+      // the next frame, and every key and character after it too, in order (a Ctrl+A whose Ctrl
+      // is let go in the frame of the A would otherwise reach it as a plain A).
+      bool pressedKey = false, holding = false;
+      const auto keyToImGui = [&](SDL_Event& e) {
+        if (!holding && e.type == SDL_KEYUP && pressedKey) holding = true;
+        if (holding) {
+          heldKeys.push_back(e);
+          return;
+        }
+        if (e.type == SDL_KEYDOWN) pressedKey = true;
+        toImGui(e);
+      };
+      std::vector<SDL_Event> fromLastFrame;
+      fromLastFrame.swap(heldKeys);
+      for (SDL_Event& held : fromLastFrame) keyToImGui(held);
       SDL_Event event;
       while (SDL_PollEvent(&event)) {
         const bool touch = event.type == SDL_FINGERDOWN || event.type == SDL_FINGERMOTION || event.type == SDL_FINGERUP;
-        if (event.type == SDL_KEYDOWN) pressedKeys.push_back(event.key.keysym.scancode);
-        const bool releasedNow = event.type == SDL_KEYUP && std::find(pressedKeys.begin(), pressedKeys.end(),
-                                                                      event.key.keysym.scancode) != pressedKeys.end();
-        if (releasedNow) heldKeyUps.push_back(event);
-        if (!touch && !releasedNow) ImGui_ImplSDL2_ProcessEvent(&event);
+        const bool key = event.type == SDL_KEYDOWN || event.type == SDL_KEYUP || event.type == SDL_TEXTINPUT;
+        if (key) {
+          keyToImGui(event);
+        } else if (!touch) {
+          toImGui(event);
+        }
         if (event.type == SDL_QUIT) running = false;
         if (event.type == SDL_MOUSEBUTTONDOWN && event.button.which != SDL_TOUCH_MOUSEID) {
           imguiMouse.press(event.button.button);
