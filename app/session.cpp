@@ -346,6 +346,9 @@ std::optional<std::string> Session::setFabric(const std::optional<std::string>& 
 std::optional<std::string> Session::tune(const sim::WorldSettings& settings) {
   try {
     world_->tune(settings);
+    // What a value half typed was refused for (a threshold of "1" on the way to "1.3") no longer
+    // holds once a value is taken: the line said it was not applied after it was.
+    if (status.rfind("not applied: ", 0) == 0) status.clear();
     return std::nullopt;
   } catch (const std::invalid_argument& error) {
     status = std::string("not applied: ") + error.what();

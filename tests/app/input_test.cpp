@@ -577,6 +577,22 @@ TEST(Session, TuningAppliesWhatItCanAndRefusesWhatItCannot) {
   EXPECT_TRUE(session.tune(tuned));
 }
 
+TEST(Session, AValueTakenAfterOneRefusedClearsTheRefusal) {
+  // Typing 1.3 into the tear threshold applies "1" on the way, which is refused: once 1.3 is taken
+  // the status line no longer says it was not applied. (Another message stays.)
+  Session session("desk");
+  sim::WorldSettings tuned = session.world().settings();
+  tuned.tearing = {true, 1.0};
+  ASSERT_TRUE(session.tune(tuned));
+  EXPECT_EQ(session.status.rfind("not applied: ", 0), 0u) << session.status;
+  tuned.tearing = {true, 1.3};
+  ASSERT_FALSE(session.tune(tuned));
+  EXPECT_EQ(session.status, "");
+  session.status = "saved drape-save.drape.json";
+  ASSERT_FALSE(session.tune(tuned));
+  EXPECT_EQ(session.status, "saved drape-save.drape.json");
+}
+
 TEST(Session, AnotherModelRestartsTheSceneWithThatModelsMaterials) {
   Session session("desk");
   ASSERT_FALSE(session.setModel(sim::Model::force, sim::Integrator::rk4)) << session.status;
