@@ -398,9 +398,15 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     }
   };
 
+  if (isSnapshot(session.path()) && session.path() != panels.fileFrom) {
+    panels.file = session.path().string();
+    panels.fileFrom = session.path();
+  }
   if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
     static const std::vector<ShippedScene> scenes = shippedScenes();
-    const std::string current = session.path().stem().string();
+    // A snapshot by its file's name (its scene's name is in the HUD's first line).
+    const std::string current =
+        isSnapshot(session.path()) ? session.path().filename().string() : session.path().stem().string();
     if (ImGui::BeginCombo("scene", current.c_str())) {
       noteWindow(panels);
       for (const ShippedScene& shipped : scenes) {

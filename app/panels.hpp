@@ -90,6 +90,9 @@ struct PanelState {
   bool showPanels = true;
   bool wantScreenshot = false;
   std::string file = "drape-save.drape.json";  // save and load
+  // The snapshot the session was opened from that `file` was last set to: a snapshot opened (from
+  // the command line, or loaded) becomes the file that Ctrl+S writes and Ctrl+O reads.
+  std::filesystem::path fileFrom;
   // Software GL (llvmpipe) pays for every sample and shadow tap: the app starts light (measured at
   // 1280 x 800 on 2 cores: 4x MSAA cost 35 ms a frame, a 2048^2 shadow map 10 ms more than 1024^2;
   // FXAA over the cloth about as much as filtering the shadows with 9 taps instead of 1, so the

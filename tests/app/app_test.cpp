@@ -274,6 +274,26 @@ TEST_F(App, AFieldLeftWithReturnGivesTheKeysBackAtOnce) {
   EXPECT_TRUE(fs::exists(file("drape-screenshot-001.png"))) << "P took a screenshot";
 }
 
+TEST_F(App, ASnapshotOpenedIsTheFileCtrlSSavesTo) {
+  // A snapshot opened from the command line is the panel's file: Ctrl+S writes it back, clock and
+  // all (it used to write drape-save.drape.json beside it).
+  const Result result = inDisplay("'" + std::string(DRAPE_CLI) +
+                                  "' run desk --time 0.5 --quiet --out mine.drape.json\n"
+                                  "\"$DRAPE\" mine.drape.json --width 640 --height 400 --exit-after 100000 &\n"
+                                  "app=$!\n" +
+                                  kFindWindow +
+                                  "sleep 1\n"
+                                  "xdotool windowfocus $window\n"
+                                  "sleep 0.2\n"
+                                  "xdotool key ctrl+s\n"
+                                  "sleep 0.5\n"
+                                  "kill $app\n"
+                                  "wait $app || true");
+  EXPECT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_FALSE(fs::exists(file("drape-save.drape.json")));
+  EXPECT_GT(state(file("mine.drape.json"))["time"].get<double>(), 0.6) << "saved again, later";
+}
+
 TEST_F(App, ResizingAndMinimisingDoNotStopIt) {
   const Result result = inDisplay(
       "\"$DRAPE\" desk --width 640 --height 400 --exit-after 100000 --out state.json &\n"
