@@ -679,6 +679,10 @@ TEST_F(Cli, ASnapshotGoesOnWhereItWasSavedBitForBit) {
   const json a = json::parse(read(whole)), b = json::parse(read(resumed));
   EXPECT_EQ(a["time"], b["time"]);
   EXPECT_EQ(a["cloths"][0]["positions"], b["cloths"][0]["positions"]);
+  // Its summary counts the steps it ran, not the clock's.
+  const Result none = run("run '" + half.string() + "' --steps 0");
+  EXPECT_NE(none.out.find("rising-sphere: 0 steps (0.000 s simulated) from its snapshot at 1.000 s"), std::string::npos)
+      << none.out;
   const Result valid = run("validate '" + half.string() + "'");
   EXPECT_EQ(valid.exitCode, 0) << valid.err;
   expectOneLineError(run("run '" + half.string() + "' --set solver.substeps=2"), 2,

@@ -200,10 +200,10 @@ int run(const RunArguments& arguments) {
       const sim::StrainStats strain = sim::structuralStrain(world);
       const sim::Energy energy = sim::energy(world);
       std::printf(
-          "%s: %lld steps (%.3f s simulated) in %.3f s; %zu cloth(s), %zu particles, %u piece(s); structural strain "
+          "%s: %s in %.3f s; %zu cloth(s), %zu particles, %u piece(s); structural strain "
           "max %.2f %%, mean %.3f %%; energy %.4g J\n",
-          scene.name.c_str(), static_cast<long long>(world.stepCount()), world.time(), seconds, world.cloths().size(),
-          countParticles(world), countPieces(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
+          scene.name.c_str(), stepsRun(input, world).c_str(), seconds, world.cloths().size(), countParticles(world),
+          countPieces(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
       if (arguments.intersectionsEvery) {
         std::printf("intersecting triangle pairs: %zu at the end, at most %zu (step %lld)\n", lastPairs, worstPairs,
                     static_cast<long long>(worstStep));

@@ -48,6 +48,21 @@ Input loadInput(const SceneArguments& arguments) {
   return {std::move(scene), std::move(snapshot)};
 }
 
+std::string stepsRun(const Input& input, const sim::World& world) {
+  const double dt = world.settings().solver.dt;
+  const std::int64_t start = input.snapshot ? std::llround(input.snapshot->time / dt) : 0;
+  const std::int64_t steps = world.stepCount() - start;
+  char text[160];
+  std::snprintf(text, sizeof text, "%lld steps (%.3f s simulated)", static_cast<long long>(steps),
+                static_cast<double>(steps) * dt);
+  std::string said = text;
+  if (input.snapshot) {
+    std::snprintf(text, sizeof text, " from its snapshot at %.3f s", input.snapshot->time);
+    said += text;
+  }
+  return said;
+}
+
 sim::World makeWorld(const scene::Scene& scene) {
   try {
     return sim::World(scene.world);

@@ -31,6 +31,9 @@ struct Input {
   std::optional<scene::Snapshot> snapshot;
 };
 Input loadInput(const SceneArguments& arguments);
+// What a summary line says of a run's steps: "N steps (T s simulated)", and where the world came
+// from a snapshot, " from its snapshot at S s" (the world's own clock went on from there).
+std::string stepsRun(const Input& input, const sim::World& world);
 
 // The engine validates too; its messages are a last line of defence behind the scene reader's.
 sim::World makeWorld(const scene::Scene& scene);

@@ -151,8 +151,8 @@ int render(const RenderArguments& arguments) {
     }
     playback.printReports();
     if (!arguments.quiet) {
-      std::printf("%s: %lld steps, %dx%d pixels, %s\n", scene.name.c_str(), static_cast<long long>(world.stepCount()),
-                  width, height, renderer->description().c_str());
+      std::printf("%s: %s, %dx%d pixels, %s\n", scene.name.c_str(), stepsRun(input, world).c_str(), width, height,
+                  renderer->description().c_str());
       if (written.size() == 1) {
         std::printf("wrote %s\n", written.front().c_str());
       } else {
