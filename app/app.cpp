@@ -210,6 +210,37 @@ void toImGui(SDL_Event& event) {
   io.KeySuper = (mod & KMOD_GUI) != 0;
 }
 
+// A key Dear ImGui does something with when it sees it held (not a character it takes as text):
+// editing and moving keys, and any key with Ctrl, Alt or the system key down.
+bool actsInImGui(const SDL_Keysym& key) {
+  switch (key.scancode) {
+    case SDL_SCANCODE_LCTRL:
+    case SDL_SCANCODE_RCTRL:
+    case SDL_SCANCODE_LSHIFT:
+    case SDL_SCANCODE_RSHIFT:
+    case SDL_SCANCODE_LALT:
+    case SDL_SCANCODE_RALT:
+    case SDL_SCANCODE_LGUI:
+    case SDL_SCANCODE_RGUI: return false;  // a modifier alone
+    case SDL_SCANCODE_RETURN:
+    case SDL_SCANCODE_KP_ENTER:
+    case SDL_SCANCODE_ESCAPE:
+    case SDL_SCANCODE_BACKSPACE:
+    case SDL_SCANCODE_DELETE:
+    case SDL_SCANCODE_TAB:
+    case SDL_SCANCODE_LEFT:
+    case SDL_SCANCODE_RIGHT:
+    case SDL_SCANCODE_UP:
+    case SDL_SCANCODE_DOWN:
+    case SDL_SCANCODE_HOME:
+    case SDL_SCANCODE_END:
+    case SDL_SCANCODE_PAGEUP:
+    case SDL_SCANCODE_PAGEDOWN:
+    case SDL_SCANCODE_INSERT: return true;
+    default: return (key.mod & (KMOD_CTRL | KMOD_ALT | KMOD_GUI)) != 0;
+  }
+}
+
 void pushTouch(SDL_Window* window, Uint32 type, int finger, glm::dvec2 at) {
   SDL_Event event{};
   event.type = type;
@@ -565,17 +596,18 @@ int runApp(const AppOptions& options) {
       // Dear ImGui (1.86) reads a key as held or not when its frame begins: a key pressed and let go
       // between two frames never reached it. A tap within one frame (xdotool's, or a quick one while
       // a frame takes long) left a panel's field open after its Return, and the next key and click
-      // went to the field. So a release that comes after a press in the same frame reaches ImGui in
-      // the next frame, and every key and character after it too, in order (a Ctrl+A whose Ctrl
-      // is let go in the frame of the A would otherwise reach it as a plain A).
-      bool pressedKey = false, holding = false;
+      // went to the field. So once a key ImGui acts on (Return, Backspace, an arrow, a Ctrl chord...)
+      // was pressed in this frame, the next release, and every key and character after it, reach
+      // ImGui in the next frame, in order (a Ctrl let go in the frame of its A would otherwise leave
+      // a plain A). Characters typed alone all go at once: ImGui takes them as text.
+      bool acted = false, holding = false;
       const auto keyToImGui = [&](SDL_Event& e) {
-        if (!holding && e.type == SDL_KEYUP && pressedKey) holding = true;
+        if (!holding && e.type == SDL_KEYUP && acted) holding = true;
         if (holding) {
           heldKeys.push_back(e);
           return;
         }
-        if (e.type == SDL_KEYDOWN) pressedKey = true;
+        if (e.type == SDL_KEYDOWN) acted = acted || actsInImGui(e.key.keysym);
         toImGui(e);
       };
       std::vector<SDL_Event> fromLastFrame;
