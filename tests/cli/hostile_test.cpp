@@ -145,6 +145,16 @@ TEST_F(Cli, CountsAreDecimalDigits) {
   EXPECT_EQ(nlohmann::json::parse(read(out))["steps"], 10);
 }
 
+TEST_F(Cli, AFileOfAnotherKindIsNamedForWhatItIs) {
+  // A scene or a snapshot given as a gesture script: said so, not "cloths: unknown key".
+  const fs::path snapshot = file("s.drape.json");
+  ASSERT_EQ(run("run desk --steps 1 --quiet --out '" + snapshot.string() + "'").exitCode, 0);
+  const std::string scene = std::string(DRAPE_ASSET_DIR) + "/scenes/desk.json";
+  expectOneLineError(run("replay desk '" + scene + "'"), 2, scene + ": a scene, not a gesture script");
+  expectOneLineError(run("replay desk '" + snapshot.string() + "'"), 2,
+                     snapshot.string() + ": a snapshot, not a gesture script");
+}
+
 // ---- OBJ colliders ----------------------------------------------------------------------------
 
 class CliMesh : public Cli {

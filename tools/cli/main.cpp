@@ -1,5 +1,7 @@
 // drape-cli: runs the Drape engine without a window. `drape-cli --help` lists the subcommands.
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -27,6 +29,19 @@ const CLI::Validator kDecimal(
     },
     "INT");
 
+// A number (CLI11's range check alone called "abc" out of range): decimal, finite.
+const CLI::Validator kNumber(
+    [](std::string& text) -> std::string {
+      double value = 0.0;
+      const char* end = text.data() + text.size();
+      const auto [at, error] = std::from_chars(text.data(), end, value);
+      if (text.empty() || error != std::errc() || at != end || !std::isfinite(value)) {
+        return "expected a number, got " + drape::scene::printable(text, 40);
+      }
+      return std::string();
+    },
+    "NUMBER");
+
 void addSceneOptions(CLI::App* command, SceneArguments& arguments) {
   command
       ->add_option("scene", arguments.scene,
@@ -40,6 +55,7 @@ void addLengthOptions(CLI::App* command, std::optional<std::int64_t>& steps, std
                                  ->transform(kDecimal)
                                  ->check(CLI::Range(std::int64_t{0}, std::int64_t{1000000000}));
   command->add_option("--time", seconds, "Simulated seconds instead of --steps")
+      ->check(kNumber)
       ->check(CLI::Range(0.0, 1.0e6))
       ->excludes(stepsOption);
 }
@@ -148,6 +164,7 @@ int main(int argc, char** argv) {
   studyCommand
       ->add_option("--choose", studyArguments.choose,
                    "Mark the cheapest configuration whose worst strain stays within this (0.05 = 5 %)")
+      ->check(kNumber)
       ->check(CLI::Range(0.0, 10.0));
   studyCommand->add_flag("--no-reference", studyArguments.noReference,
                          "No reference runs: compare time with worst strain only (much faster)");
@@ -186,6 +203,7 @@ int main(int argc, char** argv) {
   benchCommand
       ->add_option("--touch-budget", benchArguments.touchBudget,
                    "Seconds of stepping a touch case may take; it stops there and says how far it got (default 60)")
+      ->check(kNumber)
       ->check(CLI::Range(0.001, 1.0e6));
   benchCommand
       ->add_option("--touch-spread", benchArguments.touchSpread,
@@ -209,6 +227,7 @@ int main(int argc, char** argv) {
       ->add_option("--max-stretch", benchArguments.maxStretch,
                    "The most a link of hang2 may stretch that Drape's sweep works to, a fraction of its rest length "
                    "(solver.maxStretch; default hang2.json's; 0: none)")
+      ->check(kNumber)
       ->check(CLI::Range(0.0, 1.0));
   benchCommand->add_flag("--quick", benchArguments.quick,
                          "Smoke test: N = 16, 24, 10 frames, one repeat, 10 naive sweeps, touch cases at 8 x 8 for 2 s "

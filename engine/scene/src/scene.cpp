@@ -502,7 +502,24 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
   }
   json document = readJsonFile(file, "scene file", kMaxSceneFileBytes);
   for (const std::string& assignment : overrides) applyOverride(document, assignment);
-  return parseScene(document, file.string());
+  try {
+    return parseScene(document, file.string());
+  } catch (const InputError& refused) {
+    // A key an override put there (a misspelt one: "nosuch: unknown key") is the override's, not
+    // the file's: the message says which --set it came from.
+    const std::string message = refused.what(), lead = file.string() + ": ";
+    if (message.rfind(lead, 0) != 0) throw;
+    const std::string key = message.substr(lead.size(), message.find(": ", lead.size()) - lead.size());
+    for (const std::string& assignment : overrides) {
+      const std::string path = assignment.substr(0, assignment.find('='));
+      if (!key.empty() && (path == key || path.rfind(key + ".", 0) == 0)) {
+        const std::string said = message + " (from --set " + printable(assignment, 120) + ")";
+        if (dynamic_cast<const KeyConflict*>(&refused)) throw KeyConflict(said);  // (a study skips those)
+        throw InputError(said);
+      }
+    }
+    throw;
+  }
 }
 
 }  // namespace drape::scene
