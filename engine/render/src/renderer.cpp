@@ -826,15 +826,22 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   setMatrix(r.overlayProgram, "viewProjection", viewProjection);
   glEnable(GL_PROGRAM_POINT_SIZE);
   glUniform1i(uniform(r.overlayProgram, "roundPoints"), 0);
+  // A wireframe drawn at a fraction of the window's pixels is scaled up with it, each line as
+  // wide as 1 / pixelScale of the window's: faded by pixelScale, it lays as much ink as at full
+  // size (at half size the app's desk went near black under its lines, with moire).
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   for (const GpuCloth& gpu : r.cloths) {
     if (gpu.lineIndexCount == 0 || !(gpu.chain || options.wireframe)) continue;
     if (gpu.chain) {
       glVertexAttrib4f(1, 0.15f, 0.15f, 0.18f, 1.0f);
     } else {
-      glVertexAttrib4f(1, 0.08f, 0.08f, 0.10f, 1.0f);
+      glVertexAttrib4f(1, 0.08f, 0.08f, 0.10f, r.pixelScale);
     }
+    const bool faded = !gpu.chain && r.pixelScale < 1.0f;
+    if (faded) glEnable(GL_BLEND);
     glBindVertexArray(gpu.lineVao);
     glDrawElements(GL_LINES, gpu.lineIndexCount, GL_UNSIGNED_INT, nullptr);
+    if (faded) glDisable(GL_BLEND);
   }
   const float pixelsPerMetre =
       static_cast<float>(height / (2.0 * std::tan(camera.fieldOfView / 2.0) * camera.distance));
