@@ -310,6 +310,40 @@ TEST_F(RendererTest, FxaaFiltersEachFrameFromThatFramesPicture) {
   EXPECT_GT(blended(second, options), 40);  // and it was filtered
 }
 
+TEST_F(RendererTest, AWireframeAtHalfScaleLaysAboutAsMuchInkAsAtFullScale) {
+  // Drawn at half the pixels and scaled up, each line is two of the window's pixels wide: unfaded,
+  // a wireframe darkened the picture about twice as much as at full scale (the app's desk went near
+  // black). Ink: how much darker than the same picture without the wireframe, summed.
+  sim::WorldSettings settings = sheet(1.0);
+  settings.cloths[0].lattice.columns = settings.cloths[0].lattice.rows = 12;
+  settings.cloths[0].pins = {{0, 0, std::nullopt}, {11, 0, std::nullopt}};
+  const sim::World world(settings);
+  Camera camera = fromAbove(1.0);
+  camera.distance = 2.0;
+  FrameOptions options;
+  options.woven = false;
+  options.multisample = false;
+  options.fxaa = false;
+  const auto ink = [&](float scale) {
+    options.renderScale = scale;
+    options.wireframe = false;
+    renderer_->render(world, camera, kWidth, kHeight, options);
+    const std::vector<std::uint8_t> bare = renderer_->readPixels(kWidth, kHeight);
+    options.wireframe = true;
+    renderer_->render(world, camera, kWidth, kHeight, options);
+    const std::vector<std::uint8_t> wired = renderer_->readPixels(kWidth, kHeight);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < bare.size(); i += 4) {
+      for (int c = 0; c < 3; ++c) sum += std::max(0, static_cast<int>(bare[i + c]) - static_cast<int>(wired[i + c]));
+    }
+    return sum;
+  };
+  const double full = ink(1.0f), half = ink(0.5f);
+  ASSERT_GT(full, 0.0);
+  // Faded by the scale: 0.89 of the full picture's ink; unfaded, 1.46.
+  EXPECT_NEAR(half / full, 1.0, 0.25) << "full " << full << ", half " << half;
+}
+
 TEST_F(RendererTest, AtHalfScaleTheSceneIsDrawnSmallerAndStretchedOverTheSamePixels) {
   // The same sheet at render scale 1 and 0.5 covers the same part of the picture (to its stretched
   // edges); the half-scale picture is not the full one (it was drawn at a quarter of the pixels
