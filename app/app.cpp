@@ -267,7 +267,8 @@ class TouchReplay {
 
   void beforeStep(SDL_Window* window, Session& session, double aspect) {
     const double dt = session.world().settings().solver.dt;
-    // (A reset or a load mid-replay puts the clock back: the script waits for it.)
+    // (A reset or a load mid-replay moves the clock: back, and the script waits for it; on, to a
+    // snapshot's, and what was due by then comes at once.)
     const std::int64_t steps = std::max<std::int64_t>(0, session.world().stepCount() - startStep_);
     for (const interact::ReplayAction& action : clock_.advance(static_cast<double>(steps) * dt, dt)) {
       const interact::GestureEvent& e = script_.events[action.index];
@@ -563,9 +564,11 @@ int runApp(const AppOptions& options) {
       input = std::make_unique<InputMapper>(session->interaction(), session->camera());
       if (options.record) {
         Session* s = session.get();
-        session->interaction().record = [s, &recording](const interact::GestureEvent& e) {
+        // Times from the step the session began at (a snapshot's), as a replay counts them.
+        const std::int64_t from = session->world().stepCount();
+        session->interaction().record = [s, from, &recording](const interact::GestureEvent& e) {
           interact::GestureEvent timed = e;
-          timed.time = s->world().time();
+          timed.time = static_cast<double>(s->world().stepCount() - from) * s->world().settings().solver.dt;
           if (recording.events.empty() || recording.events.back().time <= timed.time) recording.events.push_back(timed);
         };
       }
@@ -600,14 +603,22 @@ int runApp(const AppOptions& options) {
       // was pressed in this frame, the next release, and every key and character after it, reach
       // ImGui in the next frame, in order (a Ctrl let go in the frame of its A would otherwise leave
       // a plain A). Characters typed alone all go at once: ImGui takes them as text.
+      // (A key pressed again in the frame it was let go in waits as well: ImGui would see it held
+      // through both frames, and take two Backspaces as one.)
       bool acted = false, holding = false;
+      std::vector<SDL_Scancode> released;
       const auto keyToImGui = [&](SDL_Event& e) {
         if (!holding && e.type == SDL_KEYUP && acted) holding = true;
+        if (!holding && e.type == SDL_KEYDOWN &&
+            std::find(released.begin(), released.end(), e.key.keysym.scancode) != released.end()) {
+          holding = true;
+        }
         if (holding) {
           heldKeys.push_back(e);
           return;
         }
         if (e.type == SDL_KEYDOWN) acted = acted || actsInImGui(e.key.keysym);
+        if (e.type == SDL_KEYUP) released.push_back(e.key.keysym.scancode);
         toImGui(e);
       };
       std::vector<SDL_Event> fromLastFrame;

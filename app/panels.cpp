@@ -398,9 +398,16 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     }
   };
 
-  if (isSnapshot(session.path()) && session.path() != panels.fileFrom) {
-    panels.file = session.path().string();
-    panels.fileFrom = session.path();
+  // The snapshot opened is the file Ctrl+S writes, while it is open: another scene chosen puts the
+  // field back, so that a save does not put that scene over the snapshot.
+  if (session.path() != panels.fileFrom) {
+    if (isSnapshot(session.path())) {
+      panels.file = session.path().string();
+      panels.fileFrom = session.path();
+    } else if (!panels.fileFrom.empty()) {
+      panels.file = PanelState{}.file;
+      panels.fileFrom.clear();
+    }
   }
   if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
     static const std::vector<ShippedScene> scenes = shippedScenes();

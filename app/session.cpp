@@ -246,6 +246,7 @@ std::optional<std::string> Session::load(const std::filesystem::path& file) {
     if (isSnapshot(file)) {
       scene::Snapshot snapshot = scene::loadSnapshot(file);
       auto world = std::make_unique<sim::World>(scene::makeWorld(snapshot));
+      alsoFramed_.clear();  // a replayed gesture's points were the first scene's
       adopt(std::move(snapshot.scene), std::move(world), file);
       status = "loaded " + file.string();
       return std::nullopt;
@@ -257,6 +258,7 @@ std::optional<std::string> Session::load(const std::filesystem::path& file) {
     } catch (const std::invalid_argument& error) {
       throw scene::InputError(loaded.source + ": " + error.what());
     }
+    alsoFramed_.clear();
     adopt(std::move(loaded), std::move(world), file);
     status = "loaded " + scene_.name;
     return std::nullopt;

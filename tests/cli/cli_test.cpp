@@ -687,6 +687,11 @@ TEST_F(Cli, ASnapshotGoesOnWhereItWasSavedBitForBit) {
       << none.out;
   const Result valid = run("validate '" + half.string() + "'");
   EXPECT_EQ(valid.exitCode, 0) << valid.err;
+  // A scene under a snapshot's name is not taken for one.
+  const fs::path misnamed = file("scene.drape.json");
+  fs::copy_file(std::string(DRAPE_ASSET_DIR) + "/scenes/desk.json", misnamed);
+  expectOneLineError(run("run '" + misnamed.string() + "'"), 2,
+                     misnamed.string() + ": not a snapshot (no \"drapeSnapshot\" key), though its name ends in");
   expectOneLineError(run("run '" + half.string() + "' --set solver.substeps=2"), 2,
                      "--set solver.substeps=2: " + half.string() + " is a snapshot, whose scene is as it was saved");
 

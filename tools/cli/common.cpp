@@ -57,7 +57,7 @@ std::string stepsRun(const Input& input, const sim::World& world) {
                 static_cast<double>(steps) * dt);
   std::string said = text;
   if (input.snapshot) {
-    std::snprintf(text, sizeof text, " from its snapshot at %.3f s", input.snapshot->time);
+    std::snprintf(text, sizeof text, " from its snapshot at %.3f s", static_cast<double>(start) * dt);
     said += text;
   }
   return said;

@@ -34,8 +34,9 @@ const CLI::Validator kNumber(
     [](std::string& text) -> std::string {
       double value = 0.0;
       const char* end = text.data() + text.size();
-      const auto [at, error] = std::from_chars(text.data(), end, value);
-      if (text.empty() || error != std::errc() || at != end || !std::isfinite(value)) {
+      const char* begin = text.data() + (text.rfind('+', 0) == 0 ? 1 : 0);  // "+1" as CLI11 took it
+      const auto [at, error] = std::from_chars(begin, end, value);
+      if (begin == end || error != std::errc() || at != end || !std::isfinite(value)) {
         return "expected a number, got " + drape::scene::printable(text, 40);
       }
       return std::string();

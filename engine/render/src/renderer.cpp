@@ -828,8 +828,9 @@ void Renderer::render(const sim::World& world, const Camera& camera, int width, 
   glUniform1i(uniform(r.overlayProgram, "roundPoints"), 0);
   // A wireframe drawn at a fraction of the window's pixels is scaled up with it, each line as
   // wide as 1 / pixelScale of the window's: faded by pixelScale, it lays as much ink as at full
-  // size (at half size the app's desk went near black under its lines, with moire).
-  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  // size (at half size the app's desk went near black under its lines, with moire). The picture's
+  // own alpha stays as it was.
+  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
   for (const GpuCloth& gpu : r.cloths) {
     if (gpu.lineIndexCount == 0 || !(gpu.chain || options.wireframe)) continue;
     if (gpu.chain) {

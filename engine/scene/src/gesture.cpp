@@ -54,8 +54,10 @@ interact::GestureScript parseGesture(const json& document, const std::string& so
   ObjectReader root(document, "", source);
   // A scene or a snapshot where a script goes: said as what it is, not as its first unknown key.
   if (root.has("drapeSnapshot") || (root.has("cloths") && !root.has("events"))) {
-    throw InputError(source + ": a " + (root.has("drapeSnapshot") ? "snapshot" : "scene") +
-                     ", not a gesture script (one is {\"events\": [...]}: docs/gestures.md)");
+    const char* what = root.has("drapeSnapshot")                  ? "a snapshot"
+                       : root.has("steps") && root.has("metrics") ? "a state drape-cli wrote"
+                                                                  : "a scene";
+    throw InputError(source + ": " + what + ", not a gesture script (one is {\"events\": [...]}: docs/gestures.md)");
   }
   (void)root.text("description", "");
   if (root.has("duration")) script.duration = root.number("duration", 1.0, {0.0, 1.0e5, true, "s"});

@@ -94,6 +94,12 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
 
 Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source) {
   ObjectReader root(document, "", source);
+  if (!root.has("drapeSnapshot")) {
+    // A scene (or a state) under a snapshot's name: said as what it is not.
+    throw InputError(source +
+                     ": not a snapshot (no \"drapeSnapshot\" key), though its name ends in .drape.json, which is a "
+                     "snapshot's: a scene file's name ends in .json alone");
+  }
   if (root.integer("drapeSnapshot", 0, kFormat, kFormat) != kFormat) root.fail("drapeSnapshot", "1", nullptr);
   Snapshot snapshot;
   snapshot.time = root.number("time", 0.0, {0.0, 1.0e9, false, "s"});
