@@ -29,6 +29,7 @@
 #include "drape/scene/error.hpp"
 #include "drape/scene/gesture.hpp"
 #include "drape/scene/output.hpp"
+#include "drape/scene/snapshot.hpp"
 #include "input.hpp"
 #include "panels.hpp"
 #include "png.hpp"
@@ -765,7 +766,7 @@ int runApp(const AppOptions& options) {
     if (options.out) {
       // A snapshot (NAME.drape.json) as the panel's save writes it, else the state as drape-cli's.
       std::optional<std::string> failed;
-      if (isSnapshot(*options.out)) {
+      if (scene::isSnapshotName(*options.out)) {
         failed = session->save(*options.out);
       } else {
         try {

@@ -14,6 +14,7 @@
 #include <imgui_internal.h>  // ClosePopupsExceptModals: Esc closes an open list
 
 #include "drape/scene/fabric.hpp"
+#include "drape/scene/snapshot.hpp"
 #include "drape/sim/intersections.hpp"
 #include "drape/sim/metrics.hpp"
 
@@ -128,7 +129,8 @@ void hud(Session& session, const PanelState& panels, const FrameStats& stats) {
   // Under the collapsed panel's title bar where they would meet (a small window: at 320 x 240 the
   // title lay across the HUD's first lines).
   float top = 10.0f;
-  if (panels.panelCollapsed && panels.panelRect[0] < 10.0f + room) {
+  // (The panel is collapsed, whenever the HUD is drawn, where it leaves no width.)
+  if (panels.panelWidth == 0.0f && panels.panelRect[0] < 10.0f + room) {
     top = std::max(top, panels.panelRect[1] + panels.panelRect[3] + 4.0f);
   }
   ImGui::SetNextWindowPos(ImVec2(10, top));
@@ -371,7 +373,6 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   ImGui::Begin("Drape");
   noteWindow(panels);
   panels.panelWidth = ImGui::IsWindowCollapsed() ? 0.0f : ImGui::GetWindowSize().x + 10.0f;
-  panels.panelCollapsed = ImGui::IsWindowCollapsed();
   {
     const ImVec2 at = ImGui::GetWindowPos(), extent = ImGui::GetWindowSize();
     constexpr float kSlack = 12.0f;  // the margin it is placed with, and a little more
@@ -401,7 +402,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
   // The snapshot opened is the file Ctrl+S writes, while it is open: another scene chosen puts the
   // field back, so that a save does not put that scene over the snapshot.
   if (session.path() != panels.fileFrom) {
-    if (isSnapshot(session.path())) {
+    if (scene::isSnapshotName(session.path())) {
       panels.file = session.path().string();
       panels.fileFrom = session.path();
     } else if (!panels.fileFrom.empty()) {
@@ -413,7 +414,7 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     static const std::vector<ShippedScene> scenes = shippedScenes();
     // A snapshot by its file's name (its scene's name is in the HUD's first line).
     const std::string current =
-        isSnapshot(session.path()) ? session.path().filename().string() : session.path().stem().string();
+        scene::isSnapshotName(session.path()) ? session.path().filename().string() : session.path().stem().string();
     if (ImGui::BeginCombo("scene", current.c_str())) {
       noteWindow(panels);
       for (const ShippedScene& shipped : scenes) {

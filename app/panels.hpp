@@ -84,7 +84,6 @@ struct PanelState {
   float panelRect[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   float lastDisplayWidth = -1.0f, lastDisplayHeight = -1.0f;  // the panel is placed again when these change
   bool collapsedBySize = false;  // the panel was collapsed because the window was too small
-  bool panelCollapsed = false;   // in the last frame (the HUD keeps clear of its title bar)
   bool showHelp = false;
   bool closePopups = false;  // Esc was pressed with a list open: close it in the next frame
   bool showPanels = true;

@@ -25,8 +25,6 @@ int FixedStepper::advance(double elapsed, double dt) {
   return steps;
 }
 
-bool isSnapshot(const std::filesystem::path& file) { return scene::isSnapshotName(file); }
-
 Session::Session(const std::filesystem::path& scene) {
   if (const std::optional<std::string> error = load(scene)) throw scene::InputError(*error);
 }
@@ -243,7 +241,7 @@ void Session::keepCameraAboveTable() {
 
 std::optional<std::string> Session::load(const std::filesystem::path& file) {
   try {
-    if (isSnapshot(file)) {
+    if (scene::isSnapshotName(file)) {
       scene::Snapshot snapshot = scene::loadSnapshot(file);
       auto world = std::make_unique<sim::World>(scene::makeWorld(snapshot));
       alsoFramed_.clear();  // a replayed gesture's points were the first scene's
@@ -279,7 +277,7 @@ std::optional<std::string> Session::save(const std::filesystem::path& file) cons
 
 void Session::reset() {
   const sim::WorldSettings tuned = world_->settings();
-  if (isSnapshot(path_)) {
+  if (scene::isSnapshotName(path_)) {
     const render::Camera keep = camera_;
     if (!load(path_)) camera_ = keep;
   } else {

@@ -16,9 +16,6 @@
 
 namespace drape::app {
 
-// Whether a file is a snapshot (the app's save, and drape-cli's `--out NAME.drape.json`) by its name.
-bool isSnapshot(const std::filesystem::path& file);
-
 // A fixed step driven by a wall clock: elapsed time accumulates and is spent in whole steps, at most
 // `maxSteps` per frame. A frame slower than that drops the rest (the simulation runs slower than
 // real time instead of spiralling: each frame catching up would take longer than the last).

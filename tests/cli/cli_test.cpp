@@ -691,7 +691,7 @@ TEST_F(Cli, ASnapshotGoesOnWhereItWasSavedBitForBit) {
   const fs::path misnamed = file("scene.drape.json");
   fs::copy_file(std::string(DRAPE_ASSET_DIR) + "/scenes/desk.json", misnamed);
   expectOneLineError(run("run '" + misnamed.string() + "'"), 2,
-                     misnamed.string() + ": not a snapshot (no \"drapeSnapshot\" key), though its name ends in");
+                     misnamed.string() + ": not a snapshot (no \"drapeSnapshot\" key): a name ending in .drape.json");
   expectOneLineError(run("run '" + half.string() + "' --set solver.substeps=2"), 2,
                      "--set solver.substeps=2: " + half.string() + " is a snapshot, whose scene is as it was saved");
 

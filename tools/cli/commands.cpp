@@ -47,14 +47,11 @@ unsigned countPieces(const sim::World& world) {
 enum class OutputKind { state, snapshot, mesh };
 
 OutputKind outputKind(const std::string& file) {
-  const std::string name = std::filesystem::path(file).filename().string();
-  const auto endsWith = [&](std::string_view tail) {
-    return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
-  };
   // A snapshot is what the app's save writes and opens: the scene and every cloth whole.
-  if (endsWith(".drape.json")) return OutputKind::snapshot;
-  if (endsWith(".json")) return OutputKind::state;
-  if (endsWith(".obj")) return OutputKind::mesh;
+  if (scene::isSnapshotName(file)) return OutputKind::snapshot;
+  const std::string extension = std::filesystem::path(file).extension().string();
+  if (extension == ".json") return OutputKind::state;
+  if (extension == ".obj") return OutputKind::mesh;
   throw scene::InputError("--out " + file +
                           ": expected a file ending in .json (state), .drape.json (a snapshot the app opens) or .obj "
                           "(mesh)");
@@ -202,7 +199,7 @@ int run(const RunArguments& arguments) {
       std::printf(
           "%s: %s in %.3f s; %zu cloth(s), %zu particles, %u piece(s); structural strain "
           "max %.2f %%, mean %.3f %%; energy %.4g J\n",
-          scene.name.c_str(), stepsRun(input, world).c_str(), seconds, world.cloths().size(), countParticles(world),
+          scene.name.c_str(), playback.stepsRun().c_str(), seconds, world.cloths().size(), countParticles(world),
           countPieces(world), 100.0 * strain.max, 100.0 * strain.mean, energy.total());
       if (arguments.intersectionsEvery) {
         std::printf("intersecting triangle pairs: %zu at the end, at most %zu (step %lld)\n", lastPairs, worstPairs,

@@ -48,21 +48,6 @@ Input loadInput(const SceneArguments& arguments) {
   return {std::move(scene), std::move(snapshot)};
 }
 
-std::string stepsRun(const Input& input, const sim::World& world) {
-  const double dt = world.settings().solver.dt;
-  const std::int64_t start = input.snapshot ? std::llround(input.snapshot->time / dt) : 0;
-  const std::int64_t steps = world.stepCount() - start;
-  char text[160];
-  std::snprintf(text, sizeof text, "%lld steps (%.3f s simulated)", static_cast<long long>(steps),
-                static_cast<double>(steps) * dt);
-  std::string said = text;
-  if (input.snapshot) {
-    std::snprintf(text, sizeof text, " from its snapshot at %.3f s", static_cast<double>(start) * dt);
-    said += text;
-  }
-  return said;
-}
-
 sim::World makeWorld(const scene::Scene& scene) {
   try {
     return sim::World(scene.world);
@@ -92,12 +77,28 @@ Playback::Playback(const scene::Scene& scene, const std::optional<std::string>& 
     : Playback(Input{scene, std::nullopt}, gesture) {}
 
 Playback::Playback(const Input& input, const std::optional<std::string>& gesture)
-    : world_(input.snapshot ? scene::makeWorld(*input.snapshot) : makeWorld(input.scene)) {
+    : world_(input.snapshot ? scene::makeWorld(*input.snapshot) : makeWorld(input.scene)),
+      startStep_(world_.stepCount()),
+      fromSnapshot_(input.snapshot.has_value()) {
   if (!gesture) return;
   script_ = scene::loadGesture(*gesture);
   interaction_ = std::make_unique<interact::Interaction>(world_);
   replay_ = std::make_unique<interact::Replay>(world_, *interaction_, *script_);
   interaction_->settings().material = scene::drawnClothTemplate(input.scene);
+}
+
+std::string Playback::stepsRun() const {
+  const double dt = world_.settings().solver.dt;
+  const std::int64_t steps = world_.stepCount() - startStep_;
+  char text[160];
+  std::snprintf(text, sizeof text, "%lld steps (%.3f s simulated)", static_cast<long long>(steps),
+                static_cast<double>(steps) * dt);
+  std::string said = text;
+  if (fromSnapshot_) {
+    std::snprintf(text, sizeof text, " from its snapshot at %.3f s", static_cast<double>(startStep_) * dt);
+    said += text;
+  }
+  return said;
 }
 
 sim::StepStatus Playback::step() { return replay_ ? replay_->step() : world_.step(); }

@@ -31,9 +31,6 @@ struct Input {
   std::optional<scene::Snapshot> snapshot;
 };
 Input loadInput(const SceneArguments& arguments);
-// What a summary line says of a run's steps: "N steps (T s simulated)", and where the world came
-// from a snapshot, " from its snapshot at S s" (the world's own clock went on from there).
-std::string stepsRun(const Input& input, const sim::World& world);
 
 // The engine validates too; its messages are a last line of defence behind the scene reader's.
 sim::World makeWorld(const scene::Scene& scene);
@@ -57,11 +54,16 @@ class Playback {
   sim::World& world() { return world_; }
   const interact::GestureScript* script() const { return script_ ? &*script_ : nullptr; }
   const interact::Interaction* interaction() const { return interaction_.get(); }
+  // What a summary line says of the steps taken since it was made: "N steps (T s simulated)", and
+  // where the world came from a snapshot, " from its snapshot at S s" (its clock went on from there).
+  std::string stepsRun() const;
   // Prints the events the replay skipped, one warning line each, to stderr.
   void printReports() const;
 
  private:
   sim::World world_;
+  std::int64_t startStep_;  // the world's step as it was made (a snapshot's, or 0)
+  bool fromSnapshot_;
   std::optional<interact::GestureScript> script_;
   std::unique_ptr<interact::Interaction> interaction_;
   std::unique_ptr<interact::Replay> replay_;

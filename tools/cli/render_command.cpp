@@ -151,7 +151,7 @@ int render(const RenderArguments& arguments) {
     }
     playback.printReports();
     if (!arguments.quiet) {
-      std::printf("%s: %s, %dx%d pixels, %s\n", scene.name.c_str(), stepsRun(input, world).c_str(), width, height,
+      std::printf("%s: %s, %dx%d pixels, %s\n", scene.name.c_str(), playback.stepsRun().c_str(), width, height,
                   renderer->description().c_str());
       if (written.size() == 1) {
         std::printf("wrote %s\n", written.front().c_str());

@@ -95,10 +95,10 @@ Snapshot loadSnapshot(const std::filesystem::path& file) {
 Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source) {
   ObjectReader root(document, "", source);
   if (!root.has("drapeSnapshot")) {
-    // A scene (or a state) under a snapshot's name: said as what it is not.
+    // A scene (or a state) under a snapshot's name (NAME.drape.json): said as what it is not.
     throw InputError(source +
-                     ": not a snapshot (no \"drapeSnapshot\" key), though its name ends in .drape.json, which is a "
-                     "snapshot's: a scene file's name ends in .json alone");
+                     ": not a snapshot (no \"drapeSnapshot\" key): a name ending in .drape.json is a snapshot's, a "
+                     "scene file's ends in .json alone");
   }
   if (root.integer("drapeSnapshot", 0, kFormat, kFormat) != kFormat) root.fail("drapeSnapshot", "1", nullptr);
   Snapshot snapshot;
