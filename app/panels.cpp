@@ -526,6 +526,15 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     changed |= sliderReal("dt (s)", tuned.solver.dt, 0.001, 0.05, "%.4f", ImGuiSliderFlags_Logarithmic);
     // The force model may have taken hundreds to stay stable (scene::withModel): the slider reaches them.
     changed |= ImGui::SliderInt("substeps", &tuned.solver.substeps, 1, std::max(32, world.settings().solver.substeps));
+    if (world.substeps() != world.settings().solver.substeps) {
+      ImGui::TextDisabled("running %d for the fabric's fine cells", world.substeps());
+      char why[200];
+      std::snprintf(why, sizeof why,
+                    "solver.fabricSubstepSpeed: a cloth with a fabric takes substeps no longer than its spacing / "
+                    "%g m/s, so that it bends as its fabric does at any spacing (docs/fabric.md)",
+                    static_cast<double>(world.settings().solver.fabricSubstepSpeed));
+      tip(why);
+    }
     // The force model has no constraint sweeps: its iterations would do nothing.
     if (tuned.solver.model == sim::Model::position) {
       changed |= ImGui::SliderInt("iterations", &tuned.solver.iterations, 0, 100);

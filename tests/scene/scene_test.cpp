@@ -404,6 +404,20 @@ TEST(SceneReader, TheStretchSolverIsNamed) {
   }
 }
 
+TEST(SceneReader, AFabricsSubstepSpeedIsReadInMetresASecondAndRefusedOutsideItsRange) {
+  EXPECT_DOUBLE_EQ(parseScene(minimal(), "s.json").world.solver.fabricSubstepSpeed, 7.5);
+  json document = minimal();
+  applyOverride(document, "solver.fabricSubstepSpeed=0");
+  EXPECT_DOUBLE_EQ(parseScene(document, "s.json").world.solver.fabricSubstepSpeed, 0.0);
+  for (const char* value : {"-1", "1e5", "\"fast\""}) {
+    json out = minimal();
+    applyOverride(out, std::string("solver.fabricSubstepSpeed=") + value);
+    EXPECT_NE(errorOf([&] { parseScene(out, "s.json"); }).find("s.json: solver.fabricSubstepSpeed: expected "),
+              std::string::npos)
+        << value;
+  }
+}
+
 TEST(SceneReader, AStretchTargetNeedsTheLinesARigidClothAndARange) {
   json document = minimal();
   applyOverride(document, "solver.stretchSolver=\"lines\"");

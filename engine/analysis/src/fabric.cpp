@@ -97,6 +97,7 @@ sim::WorldSettings labWorld(const Spec& spec) {
   sim::WorldSettings settings;
   settings.solver.dt = 1.0 / 60.0;
   settings.solver.substeps = spec.substeps;
+  settings.solver.fabricSubstepSpeed = spec.substepSpeed;
   settings.solver.iterations = spec.iterations;
   settings.solver.damping = spec.damping;
   settings.solver.stretchSolver = spec.lines ? sim::StretchSolver::lines : sim::StretchSolver::gaussSeidel;
@@ -158,6 +159,7 @@ void finishCantilever(CantileverResult& result, const sim::World& world,
                       const std::chrono::steady_clock::time_point started) {
   result.bendingLength = elasticaBendingLength(result.overhang, result.chordAngle);
   result.peirce = peirceBendingLength(result.overhang, result.chordAngle);
+  result.substeps = world.substeps();
   const sim::Cloth& c = world.cloths()[0];
   for (const sim::DistanceConstraint& link : c.rest.of(sim::ConstraintKind::stretch)) {
     const double length = glm::length(c.state.position[link.b] - c.state.position[link.a]);
@@ -329,6 +331,7 @@ CusickResult cusick(const CusickSpec& spec) {
 
   CusickResult result;
   result.particles = static_cast<int>(world.cloths()[0].state.position.size());
+  result.substeps = world.substeps();
   if (!settleToLastFrame(world, spec.settle)) {
     result.diverged = true;
     return result;

@@ -67,6 +67,7 @@ Measurement measureWorld(const sim::WorldSettings& settings, int frames, int thr
   for (int repeat = 0; repeat < std::max(repeats, 1) && (repeat == 0 || spent < kBudgetSeconds); ++repeat) {
     sim::World world(settings);
     world.setThreads(threads);
+    m.substeps = world.substeps();  // more than asked for a fine fabric (sim::substepsFor)
     double stepping = 0.0;
     for (int frame = 0; frame < frames; ++frame) {
       const auto start = Clock::now();

@@ -279,6 +279,8 @@ Scene parseScene(const json& document, const std::string& source) {
     world.solver.stretchSolver =
         *sim::parseStretchSolver(solver.choice("stretchSolver", "gauss-seidel", {"gauss-seidel", "lines"}));
     world.solver.maxStretch = solver.number("maxStretch", 0.0, {0.0, 1.0, false, "fraction of the rest length"});
+    world.solver.fabricSubstepSpeed =
+        solver.number("fabricSubstepSpeed", world.solver.fabricSubstepSpeed, {0.0, 1.0e4, false, "m/s"});
     // Keys that do not go with the others (the engine's one rule for it: sim::conflict).
     if (const std::optional<sim::SolverConflict> c = sim::conflict(world.solver)) {
       const std::string key(c->key);

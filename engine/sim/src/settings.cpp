@@ -2,6 +2,9 @@
 
 #include "drape/sim/pipeline.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace drape::sim {
 
 namespace {
@@ -89,6 +92,17 @@ SolverSettings consistent(SolverSettings solver) {
   }
   if (!solver.lines() || solver.xpbd) solver.maxStretch = 0.0;
   return solver;
+}
+
+int substepsFor(const SolverSettings& solver, Real spacing) {
+  if (solver.model != Model::position || !(solver.fabricSubstepSpeed > 0.0) || !(spacing > 0.0)) {
+    return solver.substeps;
+  }
+  // (A step of 0.0166666667 s, as scene files write 1/60, at 12.5 mm asks for 10, not 11.)
+  const double needed = std::ceil(solver.dt * static_cast<double>(solver.fabricSubstepSpeed) /
+                                  static_cast<double>(spacing) * (1.0 - 1e-6));
+  if (!(needed < static_cast<double>(kMaxSubsteps))) return kMaxSubsteps;
+  return std::max(solver.substeps, static_cast<int>(needed));
 }
 
 std::string_view name(Stage stage) {

@@ -119,6 +119,8 @@ void validate(const WorldSettings& s) {
   require(finite(solver.damping) && solver.damping >= 0.0, "solver.damping must be finite and >= 0");
   require(finite(solver.maxStretch) && solver.maxStretch >= 0.0 && solver.maxStretch <= 1.0,
           "solver.maxStretch must be a fraction from 0 to 1");
+  require(finite(solver.fabricSubstepSpeed) && solver.fabricSubstepSpeed >= 0.0,
+          "solver.fabricSubstepSpeed must be a finite number of m/s, 0 or more");
   if (const std::optional<SolverConflict> c = conflict(solver)) {
     throw std::invalid_argument("solver." + std::string(c->key) + ": " + std::string(c->value));
   }
@@ -281,6 +283,7 @@ World::World(WorldSettings settings)
   }
   require(particleCount() <= static_cast<std::size_t>(kMaxParticles), "too many particles");
   settings_.cloths.clear();  // each cloth keeps its own, in its record
+  substeps_ = substepsFor(settings_.solver, finestFabricSpacing());
   for (std::size_t c = 0; c < records_.size(); ++c) buildTethers(c);
   for (const ColliderSettings& collider : settings_.colliders) colliders_.emplace_back(collider);
   buildPipeline();
@@ -372,10 +375,10 @@ void World::buildPipeline() {
     }
     return true;
   };
-  guardCopy_ = model != Model::position                                            ? GuardCopy::before
-               : settings_.solver.substeps == 1 && onlyPositionsAfterIntegration() ? GuardCopy::none
-               : anyHeld                                                           ? GuardCopy::before
-                                                                                   : GuardCopy::integration;
+  guardCopy_ = model != Model::position                            ? GuardCopy::before
+               : substeps_ == 1 && onlyPositionsAfterIntegration() ? GuardCopy::none
+               : anyHeld                                           ? GuardCopy::before
+                                                                   : GuardCopy::integration;
   if (model == Model::position) {
     // Wind pressure's per-particle accelerations exist exactly while its stage does (tuning can
     // switch it on or off): the integrator adds them whenever the array is there.
@@ -641,8 +644,7 @@ void World::positionSubstep(Real h) {
   });
   timed(Stage::selfContact, [&](PartClock& parts) {
     if (!selfContact_) selfContact_ = std::make_unique<contact::SelfContact>();
-    selfContact_->solve(records_, settings_.selfCollision, topologyVersion_, settings_.solver.substeps - substep_,
-                        *workers_, &parts);
+    selfContact_->solve(records_, settings_.selfCollision, topologyVersion_, substeps_ - substep_, *workers_, &parts);
     // Where the contacts pushed, the constraints answer: a sweep of each cloth that pushed against
     // itself, holding what it pushed (position::sweepAfterContacts; contacts between two cloths are
     // not held, so a cloth only another pushed is left as it is), and then the contacts pushed
@@ -693,8 +695,7 @@ void World::forceSubstep(Real h) {
 
 void World::moveColliders() {
   // Contacts are made against where the colliders are at the end of the current substep.
-  const Real end = (static_cast<Real>(stepCount_) + static_cast<Real>(substep_ + 1) / settings_.solver.substeps) *
-                   settings_.solver.dt;
+  const Real end = (static_cast<Real>(stepCount_) + static_cast<Real>(substep_ + 1) / substeps_) * settings_.solver.dt;
   for (Collider& collider : colliders_) {
     if (collider.moving()) collider.setTime(end);
   }
@@ -776,7 +777,7 @@ StepStatus World::step() {
   // A step starts from its state alone: the layers' contacts its substeps hand on begin empty.
   for (ClothRecord& record : records_) record.work->solver.layerContacts.clear();
   const Real h = static_cast<Real>(substepDt());
-  for (int substep = 0; substep < settings_.solver.substeps; ++substep) {
+  for (int substep = 0; substep < substeps_; ++substep) {
     substep_ = substep;
     rowAt_ = -1;
     rowRan_ = 0;
@@ -1065,7 +1066,7 @@ Real World::fingersTwist(const Finger& finger) const {
 }
 
 void World::moveFingers(Real h) {
-  const Real n = static_cast<Real>(settings_.solver.substeps);
+  const Real n = static_cast<Real>(substeps_);
   const Real from = static_cast<Real>(substep_) / n, to = static_cast<Real>(substep_ + 1) / n;
   // Two fingers or more turn what they hold with them, as a hand's twist turns the cloth under each
   // fingertip: each grip's offset turns about its finger by the fingers' turn (fingersTwist), a
@@ -1258,6 +1259,30 @@ int World::changeTopology(
   return opened;
 }
 
+Real World::finestFabricSpacing() const {
+  Real finest = 0.0;
+  for (const ClothRecord& record : records_) {
+    if (!record.cloth.settings.fabric) continue;
+    const Real spacing = topology::madeSpacing(record.cloth);
+    if (spacing > 0.0 && (finest == 0.0 || spacing < finest)) finest = spacing;
+  }
+  return finest;
+}
+
+void World::followSpacing(Real hBefore) {
+  substeps_ = substepsFor(settings_.solver, finestFabricSpacing());
+  const Real hAfter = static_cast<Real>(substepDt());
+  if (historyStarted_ && hAfter != hBefore) {
+    // Verlet keeps velocity as x - x_prev over one substep: rescale it to the new substep.
+    for (ClothRecord& record : records_) {
+      ParticleState& s = record.cloth.state;
+      for (std::size_t i = 0; i < s.position.size(); ++i) {
+        s.previousPosition[i] = s.position[i] - (s.position[i] - s.previousPosition[i]) * (hAfter / hBefore);
+      }
+    }
+  }
+}
+
 void World::setTearing(const TearSettings& tearing) {
   validateTearing(tearing);
   settings_.tearing = tearing;
@@ -1284,16 +1309,7 @@ void World::tune(const WorldSettings& next) {
   const Real hBefore = static_cast<Real>(substepDt());
   const bool tethersChanged = candidate.solver.tethers != settings_.solver.tethers;
   settings_ = std::move(candidate);
-  const Real hAfter = static_cast<Real>(substepDt());
-  if (historyStarted_ && hAfter != hBefore) {
-    // Verlet keeps velocity as x - x_prev over one substep: rescale it to the new substep.
-    for (ClothRecord& record : records_) {
-      ParticleState& s = record.cloth.state;
-      for (std::size_t i = 0; i < s.position.size(); ++i) {
-        s.previousPosition[i] = s.position[i] - (s.position[i] - s.previousPosition[i]) * (hAfter / hBefore);
-      }
-    }
-  }
+  followSpacing(hBefore);
   for (std::size_t i = 0; i < colliders_.size(); ++i) {
     colliders_[i] = Collider(settings_.colliders[i]);
     colliders_[i].setTime(time());
@@ -1318,6 +1334,7 @@ int World::addCloth(const ClothSettings& settings) {
           "too many particles");
   records_.emplace_back(std::move(cloth));
   const std::size_t c = records_.size() - 1;
+  followSpacing(static_cast<Real>(substepDt()));  // before its history starts: made at rest, it stays so
   buildTethers(c);
   buildPipeline();
   if (historyStarted_) {
@@ -1383,6 +1400,8 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   records.reserve(cloths.size());
   for (Cloth& cloth : cloths) records.emplace_back(std::move(cloth));
   records_ = std::move(records);
+  // The cloths' histories were kept over the substep they ran at, which their spacings give again.
+  substeps_ = substepsFor(settings_.solver, finestFabricSpacing());
   for (std::size_t c = 0; c < records_.size(); ++c) {
     Cloth& cloth = records_[c].cloth;
     cloth.settings = withFabricMaterials(cloth.settings);
@@ -1419,6 +1438,7 @@ void World::removeCloth(int index) {
     }
   }
   records_.erase(records_.begin() + index);
+  followSpacing(static_cast<Real>(substepDt()));
   buildPipeline();
   topologyVersion_ = nextTopologyVersion();
   planAll();

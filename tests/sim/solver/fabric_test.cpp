@@ -246,6 +246,62 @@ TEST(Fabric, IsRefusedWhereItCannotMeanAnything) {
   EXPECT_NO_THROW(World{settings});
 }
 
+TEST(FabricSubsteps, ASubstepNoLongerThanTheSpacingOverTheSpeed) {
+  SolverSettings solver;  // 1/60 s, 1 substep, 7.5 m/s
+  EXPECT_EQ(substepsFor(solver, 0.0125), 10);
+  EXPECT_EQ(substepsFor(solver, 0.00625), 20);
+  EXPECT_EQ(substepsFor(solver, 0.003125), 40);
+  EXPECT_EQ(substepsFor(solver, 0.2), 1);  // a coarse cloth: what was asked
+  solver.dt = 0.0166666667;                // 1/60 as scene files write it: still 10, not 11
+  EXPECT_EQ(substepsFor(solver, 0.0125), 10);
+  solver.substeps = 50;  // never fewer than asked
+  EXPECT_EQ(substepsFor(solver, 0.0125), 50);
+  solver.substeps = 1;
+  EXPECT_EQ(substepsFor(solver, 1e-9), kMaxSubsteps);
+  EXPECT_EQ(substepsFor(solver, 0.0), 1);  // no cloth with a fabric
+  solver.fabricSubstepSpeed = 0.0;         // switched off
+  EXPECT_EQ(substepsFor(solver, 0.003125), 1);
+  solver.fabricSubstepSpeed = 7.5;
+  solver.model = Model::force;  // no fabric there
+  EXPECT_EQ(substepsFor(solver, 0.003125), 1);
+}
+
+TEST(FabricSubsteps, AWorldRunsWhatItsFinestFabricAsksAndKeepsItsVelocitiesAsThatChanges) {
+  // A seed sheet at 1 cm falls on its own substep; a 2.5 mm fabric sheet added asks for 50 of a
+  // 60 Hz step; taken away, the world goes back to 4. The falling sheet's velocity is the same on
+  // either side of each change (its Verlet history rescaled to the new substep).
+  WorldSettings settings = fabricSheet(11, 11, 0.1, 0.1);
+  settings.cloths[0].fabric.reset();
+  settings.solver.substeps = 4;
+  World world(settings);
+  EXPECT_EQ(world.substeps(), 4);
+  world.run(10);
+  const Vec3 before = world.velocity(0, 60);
+  ASSERT_LT(before.y, -1.0);
+  ClothSettings fine = fabricSheet(41, 41, 0.1, 0.1).cloths[0];
+  fine.lattice.origin = Vec3{2.0, 0.0, 0.0};
+  world.addCloth(fine);
+  EXPECT_EQ(world.substeps(), 50);
+  EXPECT_NEAR(glm::length(world.velocity(0, 60) - before), 0.0, 1e-9);
+  EXPECT_NEAR(world.substepDt(), 1.0 / 60.0 / 50.0, 1e-15);
+  world.run(1);
+  const Vec3 during = world.velocity(0, 60);
+  EXPECT_NEAR(during.y - before.y, -9.81 / 60.0, 1e-6);  // free fall: g dt more
+  // A shorter step asks for fewer substeps of it.
+  WorldSettings tuned = world.settings();
+  tuned.solver.dt = 1.0 / 120.0;
+  world.tune(tuned);
+  EXPECT_EQ(world.substeps(), 25);
+  EXPECT_NEAR(glm::length(world.velocity(0, 60) - during), 0.0, 1e-9);
+  world.removeCloth(1);
+  EXPECT_EQ(world.substeps(), 4);
+  EXPECT_NEAR(glm::length(world.velocity(0, 60) - during), 0.0, 1e-9);
+  // Asked for more than the fabric needs, it runs what was asked.
+  tuned.solver.substeps = 80;
+  world.tune(tuned);
+  EXPECT_EQ(world.substeps(), 80);
+}
+
 TEST(Fabric, ACutFabricBendsOnlyAlongTheLinesThatStillJoinIt) {
   World world(fabricSheet(9, 9, 0.2, 0.2));
   const std::size_t before = world.cloths()[0].rest.bending.size();

@@ -340,6 +340,23 @@ void makeTemplates(Cloth& cloth) {
 
 }  // namespace
 
+Real madeSpacing(const Cloth& cloth) {
+  const ClothSettings& settings = cloth.settings;
+  if (settings.mesh && settings.mesh->spacing > 0.0) return settings.mesh->spacing;
+  if (!settings.mesh) {
+    const LatticeSpec& l = settings.lattice;
+    Real spacing = std::numeric_limits<Real>::infinity();
+    if (l.columns > 1) spacing = std::min(spacing, l.width / (l.columns - 1));
+    if (l.rows > 1) spacing = std::min(spacing, l.height / (l.rows - 1));
+    if (std::isfinite(spacing) && spacing > 0.0) return spacing;
+  }
+  std::vector<Real> lengths;
+  for (const DistanceConstraint& c : cloth.rest.of(ConstraintKind::stretch)) lengths.push_back(c.restLength);
+  if (lengths.empty()) return 0.0;
+  std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2), lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
 void build(Cloth& cloth) {
   Topology& topology = cloth.topology;
   if (topology.built) return;
@@ -363,26 +380,7 @@ void build(Cloth& cloth) {
   makeTemplates(cloth);
   // The scale a cut snaps at: the spacing the cloth was made with (so a snapshot, which keeps the
   // settings, snaps as the world it was taken from); else the median stretch rest length.
-  const ClothSettings& settings = cloth.settings;
-  topology.spacing = 0.0;
-  if (settings.mesh) {
-    topology.spacing = settings.mesh->spacing;
-  } else {
-    const LatticeSpec& l = settings.lattice;
-    Real spacing = std::numeric_limits<Real>::infinity();
-    if (l.columns > 1) spacing = std::min(spacing, l.width / (l.columns - 1));
-    if (l.rows > 1) spacing = std::min(spacing, l.height / (l.rows - 1));
-    if (std::isfinite(spacing) && spacing > 0.0) topology.spacing = spacing;
-  }
-  if (!(topology.spacing > 0.0)) {
-    std::vector<Real> lengths;
-    for (const DistanceConstraint& c : rest.of(ConstraintKind::stretch)) lengths.push_back(c.restLength);
-    if (!lengths.empty()) {
-      std::nth_element(lengths.begin(), lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2),
-                       lengths.end());
-      topology.spacing = lengths[lengths.size() / 2];
-    }
-  }
+  topology.spacing = madeSpacing(cloth);
   topology.built = true;
 }
 

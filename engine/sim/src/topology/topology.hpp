@@ -13,6 +13,11 @@ namespace drape::sim::topology {
 // Builds the neighbours, rest areas and constraint templates from the cloth's mesh, once.
 void build(Cloth& cloth);
 
+// The spacing the cloth was made with (its settings' mesh's, or its lattice's finer one; else the
+// median stretch rest length; 0 if it has no stretch links): the scale cuts snap at and the one a
+// fabric's substeps follow (sim::substepsFor).
+Real madeSpacing(const Cloth& cloth);
+
 // Tearing through the triangles. Where a particle's triangles are stretched (C = F^T F of their
 // deformation, averaged by area) with a principal stretch beyond `threshold`, its fan breaks along
 // the line through it across that principal direction (at rest), as a cut does: new particles where

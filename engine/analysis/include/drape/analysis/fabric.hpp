@@ -29,6 +29,8 @@ struct CantileverSpec {
   double width = 0.025;      // m, ASTM D1388's strip, rounded likewise
   int substeps = 10;
   int iterations = 4;
+  // m/s: the world's solver.fabricSubstepSpeed (more substeps for a fine strip; 0: `substeps` as given)
+  double substepSpeed = sim::SolverSettings{}.fabricSubstepSpeed;
   bool lines = false;    // the stretch links a line at a time (sim::SolverSettings::lines), not one by one
   double settle = 5.0;   // s of simulated time, damped, before it is read
   double damping = 4.0;  // 1/s (global: it slows the strip, it does not change where it comes to rest)
@@ -48,6 +50,7 @@ struct CantileverResult {
   double expectedAngle = 0.0;  // radians: the elastica's angle for the fabric's own c
   double tipMotion = 0.0;      // m, how far the tip moved in the last frame (is it at rest?)
   double maxStrain = 0.0;      // the longest stretch link's strain at the end
+  int substeps = 0;            // a step's substeps as run (sim::World::substeps)
   double seconds = 0.0;        // wall-clock time the run took
   bool diverged = false;
 };
@@ -71,6 +74,7 @@ struct CusickSpec {
   double support = 0.18;     // m, the clamping discs
   int substeps = 10;
   int iterations = 4;
+  double substepSpeed = sim::SolverSettings{}.fabricSubstepSpeed;  // m/s, as CantileverSpec's
   bool lines = false;
   double settle = 5.0;    // s: the time to be at rest by
   double damping = 4.0;   // 1/s
@@ -87,6 +91,7 @@ struct CusickResult {
   // settle + longest
   double restedAt = -1.0;
   int particles = 0;
+  int substeps = 0;  // a step's substeps as run (sim::World::substeps)
   double seconds = 0.0;
   bool diverged = false;
 };

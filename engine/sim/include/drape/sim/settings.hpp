@@ -75,6 +75,14 @@ struct SolverSettings {
   // A compliant cloth (xpbd, or a fabric) stretches as its material says: the target leaves it as
   // it is.
   Real maxStretch = 0.0;
+  // m/s, position model: a cloth with a fabric takes at least as many substeps as let something
+  // moving this fast cross one of its cells in a substep, dt / substeps <= spacing / speed (0: the
+  // substeps as given). The sweeps' error in a fabric's rest shape is first order in the substep and
+  // grows as the cells shrink; at 7.5 m/s (10 substeps of a 60 Hz step at 12.5 mm, 40 at 3.125 mm)
+  // every preset's Peirce cantilever is within 3 % of its bending length at 2 and at 16 sweeps with
+  // lines, where 10 substeps left a 3.125 mm strip up to 12 % soft (docs/fabric.md). World::substeps
+  // is the count the world runs.
+  Real fabricSubstepSpeed = 7.5;
 
   bool lines() const { return stretchSolver == StretchSolver::lines; }
 };
@@ -213,5 +221,10 @@ inline constexpr int kExtraLineSteps = 4;
 // A particle farther than this from the origin is a runaway: the guard treats it like NaN.
 inline constexpr Real kRunawayDistance = 1.0e6;  // m
 inline constexpr Real kRunawaySpeed = 1.0e6;     // m/s, likewise for a stored velocity
+
+// The substeps a world with these solver settings runs for cloths whose finest fabric spacing is
+// `spacing` (m; 0 or less: no cloth has a fabric): solver.substeps, or more where
+// solver.fabricSubstepSpeed asks for them, up to kMaxSubsteps.
+int substepsFor(const SolverSettings& solver, Real spacing);
 
 }  // namespace drape::sim

@@ -216,7 +216,10 @@ class World {
   const std::vector<Collider>& colliders() const { return colliders_; }
   std::int64_t stepCount() const { return stepCount_; }
   double time() const { return static_cast<double>(stepCount_) * settings_.solver.dt; }
-  double substepDt() const { return settings_.solver.dt / settings_.solver.substeps; }
+  // The substeps a step runs: solver.substeps, or more for a fine fabric (substepsFor, with the
+  // finest spacing of its cloths that have a fabric).
+  int substeps() const { return substeps_; }
+  double substepDt() const { return settings_.solver.dt / substeps_; }
   const std::optional<Divergence>& divergence() const { return divergence_; }
   const Profile& profile() const { return profile_; }
   SelfContactStats selfContactStats() const;
@@ -297,6 +300,10 @@ class World {
  private:
   void buildPipeline();
   void buildTethers(std::size_t cloth);
+  // The finest spacing of a cloth with a fabric (0: none has one); and substeps_ made what the
+  // settings and the cloths ask for now, the Verlet histories rescaled from a substep of hBefore.
+  Real finestFabricSpacing() const;
+  void followSpacing(Real hBefore);
   // The cloth's solver plan, once per topology (and after setThreads or tune): with lines, the
   // batches and lines read off the order the cloth keeps its constraints in (orderConstraints);
   // with the seed's sweep, the order it takes them in (by particle pair). It reorders nothing. A
@@ -353,6 +360,7 @@ class World {
   // Self-contact is on: a held particle may lag its finger where the finger would drive it through
   // cloth (moveFingers).
   bool selfContactHolds_ = false;
+  int substeps_ = 1;           // what a step runs (substeps())
   int substep_ = 0;            // within the current step
   std::ptrdiff_t rowAt_ = -1;  // the profile entry of the stage the row last ran (timed)
   std::size_t rowRan_ = 0;     // stages the row ran in this substep
