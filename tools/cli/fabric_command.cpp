@@ -44,18 +44,9 @@ struct DrapeRun {
   analysis::CusickResult result;
 };
 
-// Every preset's Cusick drape at every spacing and drape setting, two runs at a time (each run is
-// one world on one thread; the results do not depend on which thread ran them).
-std::vector<DrapeRun> drapeRuns() {
-  std::vector<DrapeRun> runs;
-  for (const scene::FabricPreset& preset : scene::fabricPresets()) {
-    for (double spacing : kSpacings) {
-      for (const Setting setting : kDrapeSettings) {
-        if (spacing < 0.005 && setting.iterations > 4) continue;
-        runs.push_back({&preset, spacing, setting, {}});
-      }
-    }
-  }
+// The runs, two at a time (each run is one world on one thread; the results do not depend on which
+// thread ran them).
+std::vector<DrapeRun> drapeRuns(std::vector<DrapeRun> runs) {
   std::atomic<std::size_t> next{0};
   const auto work = [&] {
     for (std::size_t i = next++; i < runs.size(); i = next++) {
@@ -72,6 +63,33 @@ std::vector<DrapeRun> drapeRuns() {
   work();
   other.join();
   return runs;
+}
+
+// Every preset's Cusick drape at every spacing and drape setting.
+std::vector<DrapeRun> drapeRuns() {
+  std::vector<DrapeRun> runs;
+  for (const scene::FabricPreset& preset : scene::fabricPresets()) {
+    for (double spacing : kSpacings) {
+      for (const Setting setting : kDrapeSettings) {
+        if (spacing < 0.005 && setting.iterations > 4) continue;
+        runs.push_back({&preset, spacing, setting, {}});
+      }
+    }
+  }
+  return drapeRuns(std::move(runs));
+}
+
+// The issue's sizes: a disc 64 and 128 particles across (a spacing of 0.30 m / 63 and / 127), 4
+// sweeps with lines, the finest first (they take longest).
+constexpr int kIssueAcross[] = {128, 64};
+std::vector<DrapeRun> issueDrapeRuns() {
+  std::vector<DrapeRun> runs;
+  for (const int across : kIssueAcross) {
+    for (const scene::FabricPreset& preset : scene::fabricPresets()) {
+      runs.push_back({&preset, analysis::CusickSpec{}.diameter / (across - 1), Setting{10, 4, true}, {}});
+    }
+  }
+  return drapeRuns(std::move(runs));
 }
 // Run in the output folder (drawWithGnuplot): names its files relative to it. Left: each
 // cantilever run's error against its spacing, one mark a stretch setting; right: each preset's
@@ -340,6 +358,58 @@ int fabric(const FabricArguments& arguments) {
            << "  mm: 6 and 8 nodes, 0.443 and 0.524), as specimens of one fabric do on the real instrument;\n"
            << "  more folds lift more of the skirt.\n";
 
+    // At the issue's sizes.
+    const std::vector<DrapeRun> sized = issueDrapeRuns();
+    for (const DrapeRun& run : sized) {
+      const analysis::CusickResult& r = run.result;
+      char line[512];
+      std::snprintf(line, sizeof line, "%s,%g,%d,%d,lines,%.4f,%d,%.6g,%.3g,%.3f,%d,%.3f\n",
+                    std::string(run.preset->name).c_str(), run.spacing, r.substeps, run.setting.iterations,
+                    r.coefficient, r.nodes, r.shadowArea, r.motion, r.restedAt, r.particles, r.seconds);
+      drapeCsv << line;
+    }
+    report << "\n### At the issue's sizes: 64 and 128 particles across\n\n"
+           << "The same disc at the sizes issue 24 names, 64 x 64 and 128 x 128 across its 30 cm (4.76 and\n"
+           << "2.36 mm), 4 sweeps with lines, the substeps following the spacing.\n\n"
+           << "| fabric | DC at 64 | nodes | DC at 128 | nodes | moved (points) | substeps run (64, 128) | "
+              "at rest by (s, 64 / 128) | particles at 128 | runs (s) |\n"
+           << "|---|---|---|---|---|---|---|---|---|---|\n";
+    int sizedSteady = 0, sizedPairs = 0;
+    bool sizedOrdered = true;
+    double sizedWorst = 0.0;
+    std::vector<double> at128;
+    for (const scene::FabricPreset& preset : scene::fabricPresets()) {
+      const DrapeRun* fine = nullptr;
+      const DrapeRun* coarse = nullptr;
+      for (const DrapeRun& run : sized) {
+        if (run.preset != &preset) continue;
+        (run.spacing < 0.003 ? fine : coarse) = &run;
+      }
+      if (!fine || !coarse) continue;
+      const analysis::CusickResult &a = coarse->result, &b = fine->result;
+      if (a.diverged || b.diverged) {
+        report << "| " << preset.name << " | diverged |\n";
+        continue;
+      }
+      const double move = 100.0 * std::abs(b.coefficient - a.coefficient);
+      ++sizedPairs;
+      if (move <= 5.0) ++sizedSteady;
+      sizedWorst = std::max(sizedWorst, move);
+      if (preset.name != "polyester") at128.push_back(b.coefficient);
+      const auto rested = [](const analysis::CusickResult& r) {
+        return r.restedAt >= 0.0 ? format("%.2f", r.restedAt) : format("not by %g", kLastLook);
+      };
+      char line[512];
+      std::snprintf(line, sizeof line, "| %s | %.3f | %d | %.3f | %d | %.1f | %d, %d | %s / %s | %d | %.0f, %.0f |\n",
+                    std::string(preset.name).c_str(), a.coefficient, a.nodes, b.coefficient, b.nodes, move, a.substeps,
+                    b.substeps, rested(a).c_str(), rested(b).c_str(), b.particles, a.seconds, b.seconds);
+      report << line;
+    }
+    for (std::size_t k = 0; k + 1 < at128.size(); ++k) sizedOrdered = sizedOrdered && at128[k] < at128[k + 1];
+    report << "\nFrom 64 to 128 across the DC moves by at most 5 points for " << sizedSteady << " of " << sizedPairs
+           << " presets (at most " << format("%.1f", sizedWorst) << " points); at 128 across silk < jersey < "
+           << "cotton < denim: " << (sizedOrdered && at128.size() == 4 ? "yes" : "no") << ".\n";
+
     std::ostringstream spinCsv;
     spinCsv << "fabric,tilt_deg,substeps,iterations,stretch_solver,kept,drift,max_strain,seconds\n";
     report << "\n## Rotation kept\n\n"
@@ -453,7 +523,8 @@ int fabric(const FabricArguments& arguments) {
     if (!arguments.quiet) {
       std::printf("cantilever: %d of %d runs within 5 %% of the bending length; %s\n", within, runs,
                   (directory / "cantilever.csv").string().c_str());
-      std::printf("drape: ordered in %d of %d; %s\n", ordered, orders, (directory / "drape.csv").string().c_str());
+      std::printf("drape: ordered in %d of %d; from 64 to 128 across within 5 points for %d of %d presets; %s\n",
+                  ordered, orders, sizedSteady, sizedPairs, (directory / "drape.csv").string().c_str());
       std::printf("spin: %d of %d runs keep their angular momentum within 1 %%; %s\n", kept, spins,
                   (directory / "spin.csv").string().c_str());
       std::printf(
