@@ -535,6 +535,27 @@ TEST(Snapshot, AWorldWithAMovingColliderGoesOnFromItsClock) {
   EXPECT_TRUE(loaded.cloths()[0].state.position == world.cloths()[0].state.position);
 }
 
+TEST(Snapshot, ADrawnFabricClothGoesOnAtItsOwnSubstepsBitForBit) {
+  // star's drawn cloth in cotton: its substeps follow the spacing it was drawn at (sim::substepsFor),
+  // which its settings in a snapshot no longer hold (the mesh is the snapshot's own). The spacing is
+  // kept beside it: loaded, the world runs the same substeps and goes on as the saved one. Without
+  // it, the loaded world took the settings' 1 m lattice for the spacing and ran 4 substeps, not 5.
+  const Scene scene = withFabric(loadScene(resolveScenePath("star")), "cotton");
+  sim::World world(scene.world);
+  ASSERT_GT(world.substeps(), scene.world.solver.substeps);
+  ASSERT_EQ(world.run(20), sim::StepStatus::ok);
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("drape-drawn-" + std::to_string(::getpid()) + ".drape.json");
+  writeFileAtomically(file, snapshotDocument(scene, world).dump());
+  sim::World loaded = makeWorld(loadSnapshot(file));
+  std::filesystem::remove(file);
+  EXPECT_EQ(loaded.substeps(), world.substeps());
+  EXPECT_EQ(loaded.cloths()[0].spacing, world.cloths()[0].spacing);
+  ASSERT_EQ(world.run(20), sim::StepStatus::ok);
+  ASSERT_EQ(loaded.run(20), sim::StepStatus::ok);
+  EXPECT_TRUE(loaded.cloths()[0].state.position == world.cloths()[0].state.position);
+}
+
 TEST(Snapshot, ATetheredClothPinnedAndUnpinnedByHandRunsOnBitForBit) {
   // The tethers go to the cloth's own pins (Cloth::tetherPins), not to one pinned by hand (put
   // anywhere, its rest distances could not all hold); a pin taken out is none any more. A pin

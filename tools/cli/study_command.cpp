@@ -104,6 +104,8 @@ double rmsDistance(const Trajectory& a, const Trajectory& b) {
 
 scene::Scene refined(scene::Scene scene, int substepFactor, int iterationFactor) {
   scene.world.solver.substeps *= substepFactor;
+  // A fine fabric's substeps follow its spacing (sim::substepsFor): they are refined by as much.
+  scene.world.solver.fabricSubstepSpeed *= substepFactor;
   scene.world.solver.iterations *= iterationFactor;
   return scene;
 }

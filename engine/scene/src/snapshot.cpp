@@ -80,6 +80,8 @@ json snapshotDocument(const Scene& scene, const sim::World& world) {
     // a double holds each exactly, and reads back the same).
     if (!cloth.stretchTension.empty()) c["stretchTension"] = cloth.stretchTension;
     c["lattice"] = {cloth.rest.columns, cloth.rest.rows};
+    // The spacing it was made with: a drawn cloth's settings here no longer hold its mesh.
+    if (cloth.spacing > 0.0) c["spacing"] = cloth.spacing;
     cloths.push_back(std::move(c));
   }
   return {{"drapeSnapshot", kFormat},
@@ -198,6 +200,8 @@ Snapshot parseSnapshot(const nlohmann::json& document, const std::string& source
         static_cast<long long>(cloth.rest.columns) * cloth.rest.rows > static_cast<long long>(n)) {
       reader.fail("lattice", "[columns, rows] of the lattice the first particles came from", lattice);
     }
+    // (Older snapshots have none: the spacing then comes from the settings, as it did.)
+    cloth.spacing = reader.number("spacing", 0.0, {0.0, 1.0e3, false, "m"});
     reader.finish();
     if (s.position.size() != n || s.previousPosition.size() != n || s.mass.size() != n) {
       throw InputError(source + ": " + reader.pathOf("positions") + ": positions, previousPositions and masses need " +

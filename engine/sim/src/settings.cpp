@@ -101,7 +101,10 @@ int substepsFor(const SolverSettings& solver, Real spacing) {
   // (A step of 0.0166666667 s, as scene files write 1/60, at 12.5 mm asks for 10, not 11.)
   const double needed = std::ceil(solver.dt * static_cast<double>(solver.fabricSubstepSpeed) /
                                   static_cast<double>(spacing) * (1.0 - 1e-6));
-  if (!(needed < static_cast<double>(kMaxSubsteps))) return kMaxSubsteps;
+  // Never more than kMaxSubsteps, nor a substep under the 1e-9 s a world accepts.
+  const double most = std::max(static_cast<double>(solver.substeps),
+                               std::min(static_cast<double>(kMaxSubsteps), std::floor(solver.dt / 1e-9)));
+  if (!(needed < most)) return static_cast<int>(most);
   return std::max(solver.substeps, static_cast<int>(needed));
 }
 

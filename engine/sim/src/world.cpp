@@ -250,6 +250,7 @@ Cloth makeCloth(const ClothSettings& given, Model model) {
     }
   }
   cloth.piece = topology::pieces(cloth.rest, cloth.pieceCount);
+  cloth.spacing = topology::madeSpacing(cloth);
   return cloth;
 }
 
@@ -562,6 +563,7 @@ Vec3 World::velocity(int cloth, ParticleIndex particle) const {
 
 void World::startHistory(std::size_t c) {
   const Real h = static_cast<Real>(substepDt());
+  records_[c].cloth.historyStep = h;
   if (settings_.solver.model == Model::position) {
     position::startHistory(records_[c].cloth, settings_.gravity + settings_.air.drag * settings_.air.velocity,
                            settings_.solver.damping + settings_.air.drag, h);
@@ -1274,13 +1276,18 @@ void World::followSpacing(Real hBefore) {
   const Real hAfter = static_cast<Real>(substepDt());
   if (historyStarted_ && hAfter != hBefore) {
     // Verlet keeps velocity as x - x_prev over one substep: rescale it to the new substep.
-    for (ClothRecord& record : records_) {
-      ParticleState& s = record.cloth.state;
-      for (std::size_t i = 0; i < s.position.size(); ++i) {
-        s.previousPosition[i] = s.position[i] - (s.position[i] - s.previousPosition[i]) * (hAfter / hBefore);
-      }
+    for (ClothRecord& record : records_) rescaleHistory(record.cloth, hBefore, hAfter);
+  }
+}
+
+void World::rescaleHistory(Cloth& cloth, Real from, Real to) {
+  ParticleState& s = cloth.state;
+  if (from > 0.0 && to != from) {
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+      s.previousPosition[i] = s.position[i] - (s.position[i] - s.previousPosition[i]) * (to / from);
     }
   }
+  cloth.historyStep = to;
 }
 
 void World::setTearing(const TearSettings& tearing) {
@@ -1400,10 +1407,14 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   records.reserve(cloths.size());
   for (Cloth& cloth : cloths) records.emplace_back(std::move(cloth));
   records_ = std::move(records);
-  // The cloths' histories were kept over the substep they ran at, which their spacings give again.
+  // Each cloth's history was kept over the substep it ran at (historyStep; 0: this world's, as in
+  // a snapshot of it), which need not be the one these cloths' spacings ask for now: a redo can bring
+  // back the finest fabric, whose removal rescaled the others to a longer substep.
   substeps_ = substepsFor(settings_.solver, finestFabricSpacing());
   for (std::size_t c = 0; c < records_.size(); ++c) {
     Cloth& cloth = records_[c].cloth;
+    const Real h = static_cast<Real>(substepDt());
+    rescaleHistory(cloth, cloth.historyStep > 0.0 ? cloth.historyStep : h, h);
     cloth.settings = withFabricMaterials(cloth.settings);
     if (cloth.settings.fabric) cloth.rest.bending = buildBendStencils(cloth.rest);  // derived from the rest shape
     ParticleState& s = cloth.state;

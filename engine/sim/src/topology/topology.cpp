@@ -341,6 +341,7 @@ void makeTemplates(Cloth& cloth) {
 }  // namespace
 
 Real madeSpacing(const Cloth& cloth) {
+  if (cloth.spacing > 0.0) return cloth.spacing;
   const ClothSettings& settings = cloth.settings;
   if (settings.mesh && settings.mesh->spacing > 0.0) return settings.mesh->spacing;
   if (!settings.mesh) {

@@ -46,6 +46,14 @@ struct Cloth {
   // keeps none, and emptied where the cloth is torn or cut. Single precision: it only scales the
   // geometric stiffness.
   std::vector<float> stretchTension;
+  // m: the spacing the cloth was made with (topology::madeSpacing), kept by its copies and
+  // snapshots, whose settings no longer hold the drawn mesh it came from: the scale cuts snap at
+  // and a fabric's substeps follow (substepsFor). 0: worked out from the settings.
+  Real spacing = 0.0;
+  // s: the substep its previous positions lie behind its positions by (x - x_prev = v h), so that
+  // a copy put back into a world whose substep has changed since (World::restoreCloths: a redo
+  // that brings back the finest fabric) is rescaled to it. 0: the world's substep.
+  Real historyStep = 0.0;
 };
 
 // A finger holding particles (the seed's sticky finger). Each held particle keeps its offset from
@@ -304,6 +312,9 @@ class World {
   // settings and the cloths ask for now, the Verlet histories rescaled from a substep of hBefore.
   Real finestFabricSpacing() const;
   void followSpacing(Real hBefore);
+  // The cloth's previous positions moved so that x - x_prev spans a substep of `to` s, not `from`
+  // (the velocity kept), and its historyStep made `to`.
+  static void rescaleHistory(Cloth& cloth, Real from, Real to);
   // The cloth's solver plan, once per topology (and after setThreads or tune): with lines, the
   // batches and lines read off the order the cloth keeps its constraints in (orderConstraints);
   // with the seed's sweep, the order it takes them in (by particle pair). It reorders nothing. A
