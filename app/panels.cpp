@@ -528,10 +528,10 @@ std::optional<std::filesystem::path> drawPanels(Session& session, PanelState& pa
     changed |= ImGui::SliderInt("substeps", &tuned.solver.substeps, 1, std::max(32, world.settings().solver.substeps));
     if (world.substeps() != world.settings().solver.substeps) {
       ImGui::TextDisabled("running %d for the fabric's fine cells", world.substeps());
-      char why[200];
+      char why[256];
       std::snprintf(why, sizeof why,
-                    "solver.fabricSubstepSpeed: a cloth with a fabric takes substeps no longer than its spacing / "
-                    "%g m/s, so that it bends as its fabric does at any spacing (docs/fabric.md)",
+                    "solver.fabricSubstepSpeed: a world with a fabric cloth takes substeps no longer than its finest "
+                    "fabric's spacing / %g m/s, so that it bends as its fabric does at any spacing (docs/fabric.md)",
                     static_cast<double>(world.settings().solver.fabricSubstepSpeed));
       tip(why);
     }

@@ -1265,7 +1265,7 @@ Real World::finestFabricSpacing() const {
   Real finest = 0.0;
   for (const ClothRecord& record : records_) {
     if (!record.cloth.settings.fabric) continue;
-    const Real spacing = topology::madeSpacing(record.cloth);
+    const Real spacing = record.cloth.spacing;
     if (spacing > 0.0 && (finest == 0.0 || spacing < finest)) finest = spacing;
   }
   return finest;
@@ -1407,6 +1407,10 @@ void World::restoreCloths(std::vector<Cloth> cloths) {
   records.reserve(cloths.size());
   for (Cloth& cloth : cloths) records.emplace_back(std::move(cloth));
   records_ = std::move(records);
+  for (ClothRecord& record : records_) {
+    // (A snapshot from before cloths kept their spacing has none.)
+    if (!(record.cloth.spacing > 0.0)) record.cloth.spacing = topology::madeSpacing(record.cloth);
+  }
   // Each cloth's history was kept over the substep it ran at (historyStep; 0: this world's, as in
   // a snapshot of it), which need not be the one these cloths' spacings ask for now: a redo can bring
   // back the finest fabric, whose removal rescaled the others to a longer substep.

@@ -341,7 +341,6 @@ void makeTemplates(Cloth& cloth) {
 }  // namespace
 
 Real madeSpacing(const Cloth& cloth) {
-  if (cloth.spacing > 0.0) return cloth.spacing;
   const ClothSettings& settings = cloth.settings;
   if (settings.mesh && settings.mesh->spacing > 0.0) return settings.mesh->spacing;
   if (!settings.mesh) {
@@ -379,9 +378,6 @@ void build(Cloth& cloth) {
   }
   joinAlongEdges(topology, uses);
   makeTemplates(cloth);
-  // The scale a cut snaps at: the spacing the cloth was made with (so a snapshot, which keeps the
-  // settings, snaps as the world it was taken from); else the median stretch rest length.
-  topology.spacing = madeSpacing(cloth);
   topology.built = true;
 }
 
@@ -608,7 +604,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
       const Vec3 restFacing = glm::cross(rest.restPosition(c[1]) - rest.restPosition(c[0]),
                                          rest.restPosition(c[2]) - rest.restPosition(c[0]));
       const Vec3 nowFacing = glm::cross(s.position[c[1]] - s.position[c[0]], s.position[c[2]] - s.position[c[0]]);
-      const Real least = kLeastChildArea * topology.spacing * topology.spacing * glm::length(restFacing);
+      const Real least = kLeastChildArea * cloth.spacing * cloth.spacing * glm::length(restFacing);
       if (!(glm::dot(glm::cross(r[1] - r[0], r[2] - r[0]), restFacing) > least) ||
           !(glm::dot(glm::cross(y[1] - y[0], y[2] - y[0]), nowFacing) > 0.0))
         fair = false;
@@ -649,7 +645,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
     const std::int64_t k = crossingIndex(p, q);
     return k >= 0 ? static_cast<std::int64_t>(crossing[static_cast<std::size_t>(k)].second) : -1;
   };
-  const Real mergeChord = kMergeChord * topology.spacing;
+  const Real mergeChord = kMergeChord * cloth.spacing;
   std::vector<std::uint8_t> apart(crossing.size(), 0);  // crossings that keep a particle each
   std::vector<std::int64_t> partner(crossing.size());
   std::vector<std::size_t> crossingOf;  // per new particle, the (first) crossing it stands for
@@ -814,7 +810,7 @@ void openAlong(Cloth& cloth, Line& line, const std::vector<std::uint32_t>* consi
         const Vec3 nowFacing = glm::cross(s.position[c[1]] - s.position[c[0]], s.position[c[2]] - s.position[c[0]]);
         const Vec3 nowChild = glm::cross(s.position[child.corners[1]] - s.position[child.corners[0]],
                                          s.position[child.corners[2]] - s.position[child.corners[0]]);
-        if (glm::dot(n, facing) > kLeastMergedArea * size * topology.spacing * topology.spacing &&
+        if (glm::dot(n, facing) > kLeastMergedArea * size * cloth.spacing * cloth.spacing &&
             glm::dot(nowChild, nowFacing) > 0.0)
           continue;
         for (int k = 0; k < 3; ++k) {
@@ -1274,7 +1270,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
     const Real u = ahead(x);
     return u >= 0.0 && u <= length;
   };
-  Line line(n0, topology.spacing);
+  Line line(n0, cloth.spacing);
   for (const ParticleIndex p : tips) {
     if (p < n0) line.joins[p] = 1;
   }
@@ -1309,9 +1305,7 @@ bool cut(Cloth& cloth, Vec3 a, Vec3 b, Vec3 depth, std::size_t particleBudget, s
   }
   // The points of the cut near this segment's end are where the next segment of the swipe carries
   // it on from: tips left by earlier segments, particles on the cut and the new ones.
-  const auto nearEnd = [&](ParticleIndex p) {
-    return std::abs(ahead(s.position[p]) - length) <= 1.5 * topology.spacing;
-  };
+  const auto nearEnd = [&](ParticleIndex p) { return std::abs(ahead(s.position[p]) - length) <= 1.5 * cloth.spacing; };
   for (const ParticleIndex p : tips) {
     if (p < s.position.size() && nearEnd(p)) topology.cutTips.push_back(p);
   }
@@ -1455,7 +1449,7 @@ bool breakAt(Cloth& cloth, ParticleIndex v, Vec3 pull, const Incidence& incidenc
     if (way == 0.0 || best > 0.866) return false;
   }
   const auto ahead = [&](Vec3 x) { return way == 0.0 || way * glm::dot(x - at, crack) > 0.0; };
-  Line line(n0, topology.spacing);
+  Line line(n0, cloth.spacing);
   for (std::size_t p = 0; p < n0; ++p) line.place(p, glm::dot(rest.restPosition(p) - at, pull));
   line.onCut[v] = 1;
   for (const std::uint32_t t : fan) {
@@ -1645,7 +1639,7 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     std::vector<std::uint32_t> seen, within;
     const auto stressAround = [&](ParticleIndex v) {
       const Vec3 at = rest.restPosition(v);
-      const Real reach = kTipReach * cloth.topology.spacing;
+      const Real reach = kTipReach * cloth.spacing;
       for (const std::uint32_t t : seen) reached[t] = 0;
       seen.clear();
       within.clear();
@@ -1771,7 +1765,7 @@ bool tear(Cloth& cloth, Real threshold, std::size_t particleBudget, std::vector<
     const auto nearATip = [&](ParticleIndex p) {
       const Vec3 x = rest.restPosition(p);
       for (const Vec3& t : tips) {
-        if (glm::length(t - x) < kStartClear * cloth.topology.spacing) return true;
+        if (glm::length(t - x) < kStartClear * cloth.spacing) return true;
       }
       return false;
     };

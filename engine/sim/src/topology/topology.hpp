@@ -14,8 +14,7 @@ namespace drape::sim::topology {
 void build(Cloth& cloth);
 
 // The spacing the cloth was made with (its settings' mesh's, or its lattice's finer one; else the
-// median stretch rest length; 0 if it has no stretch links): the scale cuts snap at and the one a
-// fabric's substeps follow (sim::substepsFor).
+// median stretch rest length; 0 if it has no stretch links), which Cloth::spacing keeps.
 Real madeSpacing(const Cloth& cloth);
 
 // Tearing through the triangles. Where a particle's triangles are stretched (C = F^T F of their

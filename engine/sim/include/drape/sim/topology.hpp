@@ -72,7 +72,6 @@ struct Topology {
     float a, b, d;
   };
   std::vector<RestFrame> restFrames;
-  Real spacing = 0.0;  // m, the spacing the cloth was made with: the scale cuts snap at
   // Where the last cut segment ended inside a triangle: the particles it left on that triangle's
   // edge, which the next segment of the same swipe (starting at `cutEnd`) carries the cut on from.
   std::vector<ParticleIndex> cutTips;

@@ -48,7 +48,8 @@ struct Cloth {
   std::vector<float> stretchTension;
   // m: the spacing the cloth was made with (topology::madeSpacing), kept by its copies and
   // snapshots, whose settings no longer hold the drawn mesh it came from: the scale cuts snap at
-  // and a fabric's substeps follow (substepsFor). 0: worked out from the settings.
+  // and a fabric's substeps follow (substepsFor). 0 only for a cloth read from an older snapshot,
+  // until a world takes it (restoreCloths works it out).
   Real spacing = 0.0;
   // s: the substep its previous positions lie behind its positions by (x - x_prev = v h), so that
   // a copy put back into a world whose substep has changed since (World::restoreCloths: a redo
